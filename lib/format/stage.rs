@@ -1,0 +1,600 @@
+//! The versioned container every stage file uses (`.scmesh`, and later the contact
+//! model and results files).
+//!
+//! Layout (all integers little-endian), specified in `docs/formats.md`:
+//! ```text
+//! "splinecontact <format> <major>.<minor>\n"      header line, ASCII
+//! records, each starting with a 4-byte tag:
+//!   "META" u64 len, UTF-8 YAML (small structured data: names, settings)
+//!   "ARRY" u32 name_len, name, u8 dtype, u8 ndim, u64 dims[ndim], payload
+//!   "END!" u64 number of records before it, u64 checksum of every byte before "END!"
+//! ```
+//! Bulk data is raw little-endian binary (fast: a 1M-hex mesh is ~90 MB and
+//! reads in a fraction of a second); everything small is YAML so `sc-export
+//! --format yaml` can print any stage file.
+//!
+//! Readers accept the same major version with any minor version (new minor
+//! versions only add records) and refuse anything else with a message that says
+//! what was found and what is read.
+
+use std::fs;
+use std::io::{self, Read, Write};
+use std::path::{Path, PathBuf};
+
+/// Element type of an array record.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Dtype {
+    F64 = 1,
+    U32 = 2,
+    U64 = 3,
+    I32 = 4,
+    U8 = 5,
+}
+
+impl Dtype {
+    fn from_u8(v: u8) -> Option<Self> {
+        Some(match v {
+            1 => Self::F64,
+            2 => Self::U32,
+            3 => Self::U64,
+            4 => Self::I32,
+            5 => Self::U8,
+            _ => return None,
+        })
+    }
+    pub fn size(self) -> usize {
+        match self {
+            Self::F64 | Self::U64 => 8,
+            Self::U32 | Self::I32 => 4,
+            Self::U8 => 1,
+        }
+    }
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::F64 => "f64",
+            Self::U32 => "u32",
+            Self::U64 => "u64",
+            Self::I32 => "i32",
+            Self::U8 => "u8",
+        }
+    }
+}
+
+/// Typed payload of an array record.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ArrayData {
+    F64(Vec<f64>),
+    U32(Vec<u32>),
+    U64(Vec<u64>),
+    I32(Vec<i32>),
+    U8(Vec<u8>),
+}
+
+impl ArrayData {
+    pub fn dtype(&self) -> Dtype {
+        match self {
+            Self::F64(_) => Dtype::F64,
+            Self::U32(_) => Dtype::U32,
+            Self::U64(_) => Dtype::U64,
+            Self::I32(_) => Dtype::I32,
+            Self::U8(_) => Dtype::U8,
+        }
+    }
+    pub fn len(&self) -> usize {
+        match self {
+            Self::F64(v) => v.len(),
+            Self::U32(v) => v.len(),
+            Self::U64(v) => v.len(),
+            Self::I32(v) => v.len(),
+            Self::U8(v) => v.len(),
+        }
+    }
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+/// A named n-dimensional array (row-major).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Array {
+    pub name: String,
+    pub dims: Vec<u64>,
+    pub data: ArrayData,
+}
+
+/// What went wrong reading or writing a stage file. Every variant names the file.
+#[derive(Debug, thiserror::Error)]
+pub enum StageError {
+    #[error("{path}: cannot {action}: {source}")]
+    Io { path: String, action: &'static str, source: io::Error },
+    #[error("{path}: not a splinecontact stage file (expected a header line \"splinecontact {expected} <major>.<minor>\", found {found:?})")]
+    NotStageFile { path: String, expected: String, found: String },
+    #[error("{path}: is a splinecontact '{found}' file, but a '{expected}' file is expected here")]
+    WrongFormat { path: String, expected: String, found: String },
+    #[error("{path}: is {format} version {found_major}.{found_minor}; this build reads {format} {reads_major}.x (newer major versions are not understood, upgrade splinecontact)")]
+    UnsupportedVersion {
+        path: String,
+        format: String,
+        found_major: u32,
+        found_minor: u32,
+        reads_major: u32,
+    },
+    #[error("{path}: truncated at byte {offset}: {what} (the file ends early: was it written completely?)")]
+    Truncated { path: String, offset: u64, what: String },
+    #[error("{path}: corrupt at byte {offset}: {what}")]
+    Corrupt { path: String, offset: u64, what: String },
+    #[error("{path}: missing record '{name}' ({what})")]
+    Missing { path: String, name: String, what: String },
+    #[error("{path}: record '{name}': {what}")]
+    Invalid { path: String, name: String, what: String },
+}
+
+const MAGIC: &str = "splinecontact";
+
+/// 64-bit FNV-1a over 8-byte words (cheap enough for 100 MB files, catches
+/// flipped or missing bytes that lengths alone would not).
+#[derive(Clone, Copy)]
+struct Checksum(u64);
+
+impl Checksum {
+    fn new() -> Self {
+        Self(0xcbf2_9ce4_8422_2325)
+    }
+    fn update(&mut self, bytes: &[u8]) {
+        let mut h = self.0;
+        let mut chunks = bytes.chunks_exact(8);
+        for c in &mut chunks {
+            let w = u64::from_le_bytes([c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]]);
+            h = (h ^ w).wrapping_mul(0x0000_0100_0000_01b3);
+        }
+        for &b in chunks.remainder() {
+            h = (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3);
+        }
+        self.0 = h;
+    }
+}
+
+/// Builds a stage file in memory; [`StageWriter::finish`] returns its bytes.
+pub struct StageWriter {
+    buf: Vec<u8>,
+    records: u64,
+}
+
+impl StageWriter {
+    pub fn new(format: &str, major: u32, minor: u32) -> Self {
+        let mut buf = Vec::with_capacity(1 << 16);
+        buf.extend_from_slice(format!("{MAGIC} {format} {major}.{minor}\n").as_bytes());
+        Self { buf, records: 0 }
+    }
+
+    pub fn meta(&mut self, yaml: &str) {
+        self.buf.extend_from_slice(b"META");
+        self.buf.extend_from_slice(&(yaml.len() as u64).to_le_bytes());
+        self.buf.extend_from_slice(yaml.as_bytes());
+        self.records += 1;
+    }
+
+    fn array_header(&mut self, name: &str, dtype: Dtype, dims: &[u64]) {
+        self.buf.extend_from_slice(b"ARRY");
+        self.buf.extend_from_slice(&(name.len() as u32).to_le_bytes());
+        self.buf.extend_from_slice(name.as_bytes());
+        self.buf.push(dtype as u8);
+        self.buf.push(dims.len() as u8);
+        for d in dims {
+            self.buf.extend_from_slice(&d.to_le_bytes());
+        }
+        let n: u64 = dims.iter().product();
+        self.buf.reserve(n as usize * dtype.size());
+        self.records += 1;
+    }
+
+    pub fn f64s(&mut self, name: &str, dims: &[u64], v: &[f64]) {
+        debug_assert_eq!(dims.iter().product::<u64>() as usize, v.len());
+        self.array_header(name, Dtype::F64, dims);
+        v.iter().for_each(|x| self.buf.extend_from_slice(&x.to_le_bytes()));
+    }
+    pub fn u32s(&mut self, name: &str, dims: &[u64], v: &[u32]) {
+        debug_assert_eq!(dims.iter().product::<u64>() as usize, v.len());
+        self.array_header(name, Dtype::U32, dims);
+        v.iter().for_each(|x| self.buf.extend_from_slice(&x.to_le_bytes()));
+    }
+    pub fn u64s(&mut self, name: &str, dims: &[u64], v: &[u64]) {
+        debug_assert_eq!(dims.iter().product::<u64>() as usize, v.len());
+        self.array_header(name, Dtype::U64, dims);
+        v.iter().for_each(|x| self.buf.extend_from_slice(&x.to_le_bytes()));
+    }
+    pub fn i32s(&mut self, name: &str, dims: &[u64], v: &[i32]) {
+        debug_assert_eq!(dims.iter().product::<u64>() as usize, v.len());
+        self.array_header(name, Dtype::I32, dims);
+        v.iter().for_each(|x| self.buf.extend_from_slice(&x.to_le_bytes()));
+    }
+    pub fn u8s(&mut self, name: &str, dims: &[u64], v: &[u8]) {
+        debug_assert_eq!(dims.iter().product::<u64>() as usize, v.len());
+        self.array_header(name, Dtype::U8, dims);
+        self.buf.extend_from_slice(v);
+    }
+
+    /// Append the end record and return the complete file contents.
+    pub fn finish(mut self) -> Vec<u8> {
+        let mut c = Checksum::new();
+        c.update(&self.buf);
+        self.buf.extend_from_slice(b"END!");
+        self.buf.extend_from_slice(&self.records.to_le_bytes());
+        self.buf.extend_from_slice(&c.0.to_le_bytes());
+        self.buf
+    }
+}
+
+/// A stage file read into memory.
+#[derive(Debug, Clone)]
+pub struct StageFile {
+    /// Where it was read from (for messages).
+    pub path: String,
+    pub format: String,
+    pub major: u32,
+    pub minor: u32,
+    /// YAML metadata records, in file order (usually one).
+    pub meta: Vec<String>,
+    pub arrays: Vec<Array>,
+}
+
+struct Cursor<'a> {
+    bytes: &'a [u8],
+    pos: usize,
+    path: &'a str,
+}
+
+impl<'a> Cursor<'a> {
+    fn take(&mut self, n: usize, what: &str) -> Result<&'a [u8], StageError> {
+        if self.bytes.len() - self.pos < n {
+            return Err(StageError::Truncated {
+                path: self.path.to_string(),
+                offset: self.bytes.len() as u64,
+                what: format!("{what} needs {n} bytes at byte {}, only {} left", self.pos, self.bytes.len() - self.pos),
+            });
+        }
+        let s = &self.bytes[self.pos..self.pos + n];
+        self.pos += n;
+        Ok(s)
+    }
+    fn u64(&mut self, what: &str) -> Result<u64, StageError> {
+        let b = self.take(8, what)?;
+        Ok(u64::from_le_bytes(b.try_into().expect("8 bytes")))
+    }
+    fn u32(&mut self, what: &str) -> Result<u32, StageError> {
+        let b = self.take(4, what)?;
+        Ok(u32::from_le_bytes(b.try_into().expect("4 bytes")))
+    }
+    fn u8(&mut self, what: &str) -> Result<u8, StageError> {
+        Ok(self.take(1, what)?[0])
+    }
+}
+
+fn decode<T, const N: usize>(b: &[u8], f: fn([u8; N]) -> T) -> Vec<T> {
+    b.chunks_exact(N).map(|c| f(c.try_into().expect("chunk size"))).collect()
+}
+
+impl StageFile {
+    /// Parse a stage file, checking the header against `expected_format` and
+    /// `reads_major` (pass `None` to accept any format, e.g. for a dump).
+    pub fn parse(path: &str, bytes: &[u8], expected: Option<(&str, u32)>) -> Result<Self, StageError> {
+        let nl = bytes.iter().take(256).position(|&b| b == b'\n');
+        let header = nl.map(|i| String::from_utf8_lossy(&bytes[..i]).into_owned());
+        let exp_name = expected.map(|e| e.0).unwrap_or("<format>").to_string();
+        let not_stage = |found: String| StageError::NotStageFile { path: path.to_string(), expected: exp_name.clone(), found };
+        let header = match header {
+            Some(h) => h,
+            None => {
+                let shown: String = String::from_utf8_lossy(&bytes[..bytes.len().min(40)]).into_owned();
+                return Err(not_stage(shown));
+            }
+        };
+        let parts: Vec<&str> = header.split(' ').collect();
+        if parts.len() != 3 || parts[0] != MAGIC {
+            return Err(not_stage(header));
+        }
+        let format = parts[1].to_string();
+        let (major, minor) = parts[2]
+            .split_once('.')
+            .and_then(|(a, b)| Some((a.parse::<u32>().ok()?, b.parse::<u32>().ok()?)))
+            .ok_or_else(|| not_stage(header.clone()))?;
+        if let Some((name, reads_major)) = expected {
+            if format != name {
+                return Err(StageError::WrongFormat { path: path.to_string(), expected: name.to_string(), found: format });
+            }
+            if major != reads_major {
+                return Err(StageError::UnsupportedVersion {
+                    path: path.to_string(),
+                    format,
+                    found_major: major,
+                    found_minor: minor,
+                    reads_major,
+                });
+            }
+        }
+        let mut c = Cursor { bytes, pos: header.len() + 1, path };
+        let mut meta = Vec::new();
+        let mut arrays = Vec::new();
+        let mut records = 0u64;
+        loop {
+            let at = c.pos;
+            let tag = c.take(4, "a record tag")?;
+            match tag {
+                b"META" => {
+                    let len = c.u64("META length")? as usize;
+                    let text = c.take(len, "META text")?;
+                    let text = std::str::from_utf8(text).map_err(|e| StageError::Corrupt {
+                        path: path.to_string(),
+                        offset: at as u64,
+                        what: format!("META record is not UTF-8: {e}"),
+                    })?;
+                    meta.push(text.to_string());
+                }
+                b"ARRY" => {
+                    let name_len = c.u32("array name length")? as usize;
+                    if name_len > 4096 {
+                        return Err(StageError::Corrupt { path: path.to_string(), offset: at as u64, what: format!("array name length {name_len} is implausible") });
+                    }
+                    let name = String::from_utf8_lossy(c.take(name_len, "array name")?).into_owned();
+                    let dt = c.u8("array dtype")?;
+                    let dtype = Dtype::from_u8(dt).ok_or_else(|| StageError::Corrupt {
+                        path: path.to_string(),
+                        offset: at as u64,
+                        what: format!("array '{name}' has unknown dtype code {dt}"),
+                    })?;
+                    let ndim = c.u8("array rank")? as usize;
+                    let mut dims = Vec::with_capacity(ndim);
+                    for _ in 0..ndim {
+                        dims.push(c.u64("array dimension")?);
+                    }
+                    let n = dims.iter().try_fold(1u64, |a, &d| a.checked_mul(d)).and_then(|n| n.checked_mul(dtype.size() as u64));
+                    let nbytes = match n {
+                        Some(n) if n <= bytes.len() as u64 => n as usize,
+                        _ => {
+                            return Err(StageError::Truncated {
+                                path: path.to_string(),
+                                offset: bytes.len() as u64,
+                                what: format!("array '{name}' of shape {dims:?} does not fit in the file"),
+                            })
+                        }
+                    };
+                    let b = c.take(nbytes, &format!("data of array '{name}'"))?;
+                    let data = match dtype {
+                        Dtype::F64 => ArrayData::F64(decode(b, f64::from_le_bytes)),
+                        Dtype::U32 => ArrayData::U32(decode(b, u32::from_le_bytes)),
+                        Dtype::U64 => ArrayData::U64(decode(b, u64::from_le_bytes)),
+                        Dtype::I32 => ArrayData::I32(decode(b, i32::from_le_bytes)),
+                        Dtype::U8 => ArrayData::U8(b.to_vec()),
+                    };
+                    arrays.push(Array { name, dims, data });
+                }
+                b"END!" => {
+                    let count = c.u64("END record count")?;
+                    let sum = c.u64("END checksum")?;
+                    if count != records {
+                        return Err(StageError::Corrupt { path: path.to_string(), offset: at as u64, what: format!("END says {count} records, found {records}") });
+                    }
+                    let mut ck = Checksum::new();
+                    ck.update(&bytes[..at]);
+                    if ck.0 != sum {
+                        return Err(StageError::Corrupt { path: path.to_string(), offset: at as u64, what: "checksum mismatch: the file was modified or damaged".into() });
+                    }
+                    break;
+                }
+                other => {
+                    return Err(StageError::Corrupt {
+                        path: path.to_string(),
+                        offset: at as u64,
+                        what: format!("unknown record tag {:?} (expected META, ARRY or END!)", String::from_utf8_lossy(other)),
+                    })
+                }
+            }
+            records += 1;
+        }
+        Ok(Self { path: path.to_string(), format, major, minor, meta, arrays })
+    }
+
+    /// Read a file (or standard input for `-`) and parse it.
+    pub fn read(path: &Path, expected: Option<(&str, u32)>) -> Result<Self, StageError> {
+        let shown = path.display().to_string();
+        let bytes = read_input(path).map_err(|source| StageError::Io { path: shown.clone(), action: "read", source })?;
+        Self::parse(&shown, &bytes, expected)
+    }
+
+    pub fn array(&self, name: &str) -> Option<&Array> {
+        self.arrays.iter().find(|a| a.name == name)
+    }
+
+    fn missing(&self, name: &str, what: &str) -> StageError {
+        StageError::Missing { path: self.path.clone(), name: name.to_string(), what: what.to_string() }
+    }
+
+    pub fn invalid(&self, name: &str, what: impl Into<String>) -> StageError {
+        StageError::Invalid { path: self.path.clone(), name: name.to_string(), what: what.into() }
+    }
+
+    fn typed<'a, T>(&'a self, name: &str, cols: Option<u64>, pick: fn(&'a ArrayData) -> Option<&'a Vec<T>>, dtype: Dtype) -> Result<&'a [T], StageError> {
+        let a = self.array(name).ok_or_else(|| self.missing(name, dtype.name()))?;
+        let v = pick(&a.data).ok_or_else(|| self.invalid(name, format!("expected dtype {}, found {}", dtype.name(), a.data.dtype().name())))?;
+        if let Some(c) = cols {
+            if a.dims.len() != 2 || a.dims[1] != c {
+                return Err(self.invalid(name, format!("expected shape [n, {c}], found {:?}", a.dims)));
+            }
+        }
+        Ok(v)
+    }
+
+    /// The f64 array `name`; with `cols`, checks it has shape `[n, cols]`.
+    pub fn f64s(&self, name: &str, cols: Option<u64>) -> Result<&[f64], StageError> {
+        self.typed(name, cols, |d| if let ArrayData::F64(v) = d { Some(v) } else { None }, Dtype::F64)
+    }
+    pub fn u32s(&self, name: &str, cols: Option<u64>) -> Result<&[u32], StageError> {
+        self.typed(name, cols, |d| if let ArrayData::U32(v) = d { Some(v) } else { None }, Dtype::U32)
+    }
+    pub fn u64s(&self, name: &str, cols: Option<u64>) -> Result<&[u64], StageError> {
+        self.typed(name, cols, |d| if let ArrayData::U64(v) = d { Some(v) } else { None }, Dtype::U64)
+    }
+    pub fn i32s(&self, name: &str, cols: Option<u64>) -> Result<&[i32], StageError> {
+        self.typed(name, cols, |d| if let ArrayData::I32(v) = d { Some(v) } else { None }, Dtype::I32)
+    }
+    pub fn u8s(&self, name: &str, cols: Option<u64>) -> Result<&[u8], StageError> {
+        self.typed(name, cols, |d| if let ArrayData::U8(v) = d { Some(v) } else { None }, Dtype::U8)
+    }
+
+    /// The first META record, deserialised.
+    pub fn meta_as<T: serde::de::DeserializeOwned>(&self) -> Result<T, StageError> {
+        let text = self.meta.first().ok_or_else(|| self.missing("META", "metadata"))?;
+        serde_yaml::from_str(text).map_err(|e| self.invalid("META", e.to_string()))
+    }
+
+    /// Human-readable dump: header, metadata, then each array as YAML rows.
+    pub fn dump_yaml(&self, out: &mut dyn Write) -> io::Result<()> {
+        writeln!(out, "format: {}", self.format)?;
+        writeln!(out, "version: \"{}.{}\"", self.major, self.minor)?;
+        for (i, m) in self.meta.iter().enumerate() {
+            writeln!(out, "meta{}:", if i == 0 { String::new() } else { format!("_{i}") })?;
+            for line in m.lines() {
+                writeln!(out, "  {line}")?;
+            }
+        }
+        writeln!(out, "arrays:")?;
+        for a in &self.arrays {
+            writeln!(out, "  {:?}:", a.name)?;
+            writeln!(out, "    dtype: {}", a.data.dtype().name())?;
+            writeln!(out, "    shape: {:?}", a.dims)?;
+            writeln!(out, "    data:")?;
+            let cols = if a.dims.len() >= 2 { a.dims[1..].iter().product::<u64>() as usize } else { 1 };
+            let rows = if cols == 0 { 0 } else { a.data.len() / cols };
+            for r in 0..rows {
+                let range = r * cols..(r + 1) * cols;
+                let row: Vec<String> = match &a.data {
+                    // `{:?}` prints the shortest string that round-trips the f64 exactly.
+                    ArrayData::F64(v) => v[range].iter().map(|x| format!("{x:?}")).collect(),
+                    ArrayData::U32(v) => v[range].iter().map(|x| x.to_string()).collect(),
+                    ArrayData::U64(v) => v[range].iter().map(|x| x.to_string()).collect(),
+                    ArrayData::I32(v) => v[range].iter().map(|x| x.to_string()).collect(),
+                    ArrayData::U8(v) => v[range].iter().map(|x| x.to_string()).collect(),
+                };
+                if cols == 1 && a.dims.len() < 2 {
+                    writeln!(out, "      - {}", row[0])?;
+                } else {
+                    writeln!(out, "      - [{}]", row.join(", "))?;
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Read a whole file, or standard input when the path is `-`.
+pub fn read_input(path: &Path) -> io::Result<Vec<u8>> {
+    if path.as_os_str() == "-" {
+        let mut v = Vec::new();
+        io::stdin().lock().read_to_end(&mut v)?;
+        Ok(v)
+    } else {
+        fs::read(path)
+    }
+}
+
+/// Write `bytes` to `path` atomically: into a temporary file in the same folder,
+/// then renamed over the target, so a failure never leaves a half-written file.
+/// The path `-` writes to standard output.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), StageError> {
+    write_atomic_with(path, |w| w.write_all(bytes))
+}
+
+/// Like [`write_atomic`], with the contents produced by a callback writing into a
+/// buffered temporary file.
+pub fn write_atomic_with(path: &Path, f: impl FnOnce(&mut dyn Write) -> io::Result<()>) -> Result<(), StageError> {
+    let shown = path.display().to_string();
+    let io_err = |action: &'static str| {
+        let shown = shown.clone();
+        move |source| StageError::Io { path: shown, action, source }
+    };
+    if path.as_os_str() == "-" {
+        let mut buf = Vec::new();
+        f(&mut buf).map_err(io_err("produce"))?;
+        let mut out = io::stdout().lock();
+        out.write_all(&buf).and_then(|_| out.flush()).map_err(io_err("write to standard output"))?;
+        return Ok(());
+    }
+    let tmp = temp_path(path);
+    let result = (|| -> io::Result<()> {
+        let file = fs::File::create(&tmp)?;
+        let mut w = io::BufWriter::with_capacity(1 << 20, file);
+        f(&mut w)?;
+        let file = w.into_inner().map_err(|e| e.into_error())?;
+        file.sync_data()?;
+        Ok(())
+    })();
+    if let Err(e) = result {
+        let _ = fs::remove_file(&tmp);
+        return Err(StageError::Io { path: shown, action: "write", source: e });
+    }
+    fs::rename(&tmp, path).map_err(|e| {
+        let _ = fs::remove_file(&tmp);
+        StageError::Io { path: shown, action: "rename the temporary file onto", source: e }
+    })
+}
+
+/// `dir/.name.<pid>.tmp` beside the target (same file system, so rename is atomic).
+pub fn temp_path(path: &Path) -> PathBuf {
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "out".into());
+    let tmp = format!(".{name}.{}.tmp", std::process::id());
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.join(tmp),
+        _ => PathBuf::from(tmp),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample() -> Vec<u8> {
+        let mut w = StageWriter::new("demo", 1, 2);
+        w.meta("name: test\n");
+        w.f64s("x", &[2, 3], &[0.1, -2.5e300, f64::MIN_POSITIVE, 1.0 / 3.0, -0.0, 7.0]);
+        w.u32s("ids", &[3], &[1, 2, 3]);
+        w.finish()
+    }
+
+    #[test]
+    fn round_trip_is_bit_exact() {
+        let f = StageFile::parse("t", &sample(), Some(("demo", 1))).unwrap();
+        assert_eq!(f.minor, 2);
+        let x = f.f64s("x", Some(3)).unwrap();
+        assert_eq!(x[3].to_bits(), (1.0f64 / 3.0).to_bits());
+        assert_eq!(x[4].to_bits(), (-0.0f64).to_bits());
+        assert_eq!(f.u32s("ids", None).unwrap(), &[1, 2, 3]);
+        assert_eq!(f.meta[0], "name: test\n");
+    }
+
+    #[test]
+    fn every_truncation_is_detected() {
+        let b = sample();
+        for n in 0..b.len() {
+            let e = StageFile::parse("t", &b[..n], Some(("demo", 1))).unwrap_err();
+            let msg = e.to_string();
+            assert!(msg.contains("truncated") || msg.contains("not a splinecontact"), "{n}: {msg}");
+        }
+    }
+
+    #[test]
+    fn flipped_byte_is_detected() {
+        let mut b = sample();
+        let i = b.len() / 2;
+        b[i] ^= 0x10;
+        assert!(StageFile::parse("t", &b, Some(("demo", 1))).is_err());
+    }
+
+    #[test]
+    fn newer_major_and_wrong_format_are_refused() {
+        let b = StageWriter::new("demo", 2, 0).finish();
+        let e = StageFile::parse("f.demo", &b, Some(("demo", 1))).unwrap_err().to_string();
+        assert!(e.contains("version 2.0") && e.contains("reads demo 1.x"), "{e}");
+        let e = StageFile::parse("f.demo", &b, Some(("scmesh", 1))).unwrap_err().to_string();
+        assert!(e.contains("'demo' file") && e.contains("'scmesh' file is expected"), "{e}");
+    }
+}

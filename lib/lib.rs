@@ -1,0 +1,23 @@
+//! # splinecontact
+//!
+//! 3D large-deformation frictional contact of hex8 bodies with the master surface
+//! smoothed by one B-spline patch, after Santos & Bandeira (2018), *Numerical
+//! modeling of contact problems with the finite element method utilizing a B-Spline
+//! surface for contact surface smoothing*, Lat. Am. J. Solids Struct. 15(5).
+//!
+//! ## Crate map
+//! | module   | what it holds |
+//! |----------|---------------|
+//! | `format` | on-disk formats: stage container, `.scmesh`, gmsh MSH, VTK, pipeline YAML |
+//! | `mesh`   | the mesh: nodes, hex8, bodies, node and face sets, hex8 topology |
+//!
+//! ## Notation (paper symbol ↔ Rust name ↔ equation)
+//! | paper | Rust | eq. |
+//! |-------|------|-----|
+//! | F, J = det F, b = F Fᵀ | `F`, `J`, `b` | 3.3 |
+//! | σ (Cauchy) | `sigma` | 3.3 |
+//! | g_N, t_N, λ_N, ε_N | `g_n`, `t_n`, `lambda_n`, `eps_n` | 4.2–4.3 |
+//! | ξ̄^α, ā_α, ā_αβ, b̄_αβ | `xi`, `a_alpha`, `a_ab`, `b_ab` | 4.10–4.13 |
+
+pub mod format;
+pub mod mesh;
