@@ -1,1 +1,43 @@
-fn main() {}
+//! sc-pipeline: run the stages of a YAML pipeline in order.
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::Parser;
+
+/// Run a splinecontact pipeline: the stages listed in a YAML file (gmsh, import,
+/// export, …), in order, through the real files between them.
+///
+/// Relative paths in the YAML are resolved against the YAML's own folder, so a
+/// pipeline runs the same from any working directory. Each stage is printed as it
+/// starts; the first failing stage stops the run with its error (exit code 2 for
+/// bad input, 1 for I/O, 3 for a solve that did not converge). The schema is in
+/// docs/pipelines.md.
+///
+/// Example:
+///   sc-pipeline pipelines/parisch.yaml
+#[derive(Parser)]
+#[command(version, about, long_about, verbatim_doc_comment)]
+struct Args {
+    /// The pipeline YAML file.
+    pipeline: PathBuf,
+    /// Print nothing but errors.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+fn main() -> ExitCode {
+    let args = Args::parse();
+    let quiet = args.quiet;
+    let mut log = |line: &str| {
+        if !quiet {
+            eprintln!("{line}");
+        }
+    };
+    match splinecontact::pipeline::run(&args.pipeline, &mut log) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("sc-pipeline: error: {e}");
+            ExitCode::from(e.exit_code())
+        }
+    }
+}

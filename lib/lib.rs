@@ -10,6 +10,8 @@
 //! |----------|---------------|
 //! | `format` | on-disk formats: stage container, `.scmesh`, gmsh MSH, VTK, pipeline YAML |
 //! | `mesh`   | the mesh: nodes, hex8, bodies, node and face sets, hex8 topology |
+//! | `stages` | each pipeline stage as a library call (the binaries are thin wrappers) |
+//! | `pipeline` | the YAML pipeline runner |
 //!
 //! ## Notation (paper symbol ↔ Rust name ↔ equation)
 //! | paper | Rust | eq. |
@@ -21,3 +23,5 @@
 
 pub mod format;
 pub mod mesh;
+pub mod pipeline;
+pub mod stages;

@@ -1,0 +1,153 @@
+//! The pipeline YAML schema (documented key by key in `docs/pipelines.md`).
+//!
+//! ```yaml
+//! version: 1
+//! name: parisch                  # optional, for messages
+//! stages:
+//!   - import: { input: ../meshes/parisch.msh, output: out/parisch.scmesh }
+//!   - export: { input: out/parisch.scmesh, output: out/parisch.vtu }
+//! ```
+//! Every struct denies unknown keys, so a misspelt key is an error that names it
+//! and its line (serde_yaml reports `at line L column C`).
+
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+
+use crate::stages::export::ExportFormat;
+use crate::stages::gmsh::MshFlavour;
+
+/// The pipeline versions this build reads.
+pub const VERSION: u32 = 1;
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Pipeline {
+    /// Schema version; must be 1.
+    pub version: u32,
+    #[serde(default)]
+    pub name: Option<String>,
+    /// serde_yaml 0.9 reads enums only as `!tag`s; `singleton_map_recursive`
+    /// restores the natural one-key-map form `- import: {...}`.
+    #[serde(with = "serde_yaml::with::singleton_map_recursive")]
+    pub stages: Vec<Stage>,
+}
+
+/// One stage: a map with a single key naming the stage.
+#[derive(Debug, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Stage {
+    Gmsh(GmshStage),
+    Import(ImportStage),
+    Export(ExportStage),
+}
+
+impl Stage {
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Gmsh(_) => "gmsh",
+            Self::Import(_) => "import",
+            Self::Export(_) => "export",
+        }
+    }
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GmshStage {
+    /// The `.geo` to mesh in 3D.
+    pub geo: PathBuf,
+    /// The `.msh` to write.
+    pub output: PathBuf,
+    #[serde(default)]
+    pub format: MshFlavour,
+    #[serde(default)]
+    pub binary: bool,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ImportStage {
+    pub input: PathBuf,
+    pub output: PathBuf,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExportStage {
+    pub input: PathBuf,
+    pub output: PathBuf,
+    #[serde(default)]
+    pub format: Option<ExportFormat>,
+}
+
+/// A pipeline file could not be read.
+#[derive(Debug, thiserror::Error)]
+pub enum PipelineError {
+    #[error("{path}: cannot read: {source}")]
+    Io { path: String, source: std::io::Error },
+    #[error("{path}: {message}")]
+    Yaml { path: String, message: String },
+    #[error("{path}: pipeline version {found} is not read by this build (it reads version {VERSION})")]
+    Version { path: String, found: u32 },
+}
+
+impl Pipeline {
+    /// Parse a pipeline from YAML text (`path` is for messages).
+    pub fn parse(path: &str, text: &str) -> Result<Self, PipelineError> {
+        let p: Pipeline = serde_yaml::from_str(text).map_err(|e| PipelineError::Yaml { path: path.to_string(), message: e.to_string() })?;
+        if p.version != VERSION {
+            return Err(PipelineError::Version { path: path.to_string(), found: p.version });
+        }
+        Ok(p)
+    }
+
+    pub fn read(path: &Path) -> Result<Self, PipelineError> {
+        let shown = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|source| PipelineError::Io { path: shown.clone(), source })?;
+        Self::parse(&shown, &text)
+    }
+}
+
+/// Resolve a path from the YAML against the YAML's folder (absolute paths and `-`
+/// are kept as they are).
+pub fn resolve(base: &Path, p: &Path) -> PathBuf {
+    if p.is_absolute() || p.as_os_str() == "-" {
+        p.to_path_buf()
+    } else {
+        base.join(p)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn unknown_key_names_key_and_line() {
+        let y = "version: 1\nstages:\n  - import:\n      input: a.msh\n      outptu: b.scmesh\n";
+        let e = Pipeline::parse("p.yaml", y).unwrap_err().to_string();
+        assert!(e.contains("outptu") && e.contains("line 5"), "{e}");
+    }
+
+    #[test]
+    fn unknown_stage_lists_the_known_ones() {
+        let y = "version: 1\nstages:\n  - imprt: {input: a, output: b}\n";
+        let e = Pipeline::parse("p.yaml", y).unwrap_err().to_string();
+        assert!(e.contains("imprt") && e.contains("import") && e.contains("line 3"), "{e}");
+    }
+
+    #[test]
+    fn wrong_type_names_line() {
+        let y = "version: 1\nstages:\n  - gmsh: {geo: a.geo, output: b.msh, binary: maybe}\n";
+        let e = Pipeline::parse("p.yaml", y).unwrap_err().to_string();
+        assert!(e.contains("binary") || e.contains("boolean"), "{e}");
+        assert!(e.contains("line 3"), "{e}");
+    }
+
+    #[test]
+    fn newer_version_is_refused() {
+        let e = Pipeline::parse("p.yaml", "version: 2\nstages: []\n").unwrap_err().to_string();
+        assert!(e.contains("version 2"), "{e}");
+    }
+}

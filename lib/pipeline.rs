@@ -1,0 +1,74 @@
+//! The pipeline runner: the stages of a YAML pipeline, in order, through the real
+//! files between them; it stops at the first failing stage with that stage's error.
+
+use std::path::{Path, PathBuf};
+
+use crate::format::pipeline::{resolve, Pipeline, PipelineError, Stage};
+use crate::stages::{self, StageRunError};
+
+/// A failed pipeline: which stage, and why.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    #[error(transparent)]
+    Pipeline(#[from] PipelineError),
+    #[error("stage {index} ({name}) failed: {source}")]
+    Stage { index: usize, name: &'static str, source: StageRunError },
+}
+
+impl RunError {
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            Self::Pipeline(PipelineError::Io { .. }) => stages::exit_code::IO,
+            Self::Pipeline(_) => stages::exit_code::BAD_INPUT,
+            Self::Stage { source, .. } => source.exit_code(),
+        }
+    }
+}
+
+fn ensure_parent(p: &Path) -> Result<(), StageRunError> {
+    match p.parent() {
+        Some(d) if !d.as_os_str().is_empty() && !d.exists() => std::fs::create_dir_all(d)
+            .map_err(|e| StageRunError::Tool(format!("{}: cannot create folder: {e}", d.display()))),
+        _ => Ok(()),
+    }
+}
+
+/// Run every stage of the pipeline at `path`; `log` receives one line per event.
+pub fn run(path: &Path, log: &mut dyn FnMut(&str)) -> Result<(), RunError> {
+    let pipeline = Pipeline::read(path)?;
+    let base: PathBuf = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let n = pipeline.stages.len();
+    if let Some(name) = &pipeline.name {
+        log(&format!("pipeline {name}: {n} stages"));
+    }
+    for (i, stage) in pipeline.stages.iter().enumerate() {
+        let index = i + 1;
+        let fail = |source| RunError::Stage { index, name: stage.name(), source };
+        match stage {
+            Stage::Gmsh(s) => {
+                let (geo, out) = (resolve(&base, &s.geo), resolve(&base, &s.output));
+                log(&format!("[{index}/{n}] gmsh {} -> {}", geo.display(), out.display()));
+                ensure_parent(&out).map_err(fail)?;
+                stages::gmsh::run_gmsh(&geo, &out, s.format, s.binary).map_err(fail)?;
+            }
+            Stage::Import(s) => {
+                let (input, out) = (resolve(&base, &s.input), resolve(&base, &s.output));
+                log(&format!("[{index}/{n}] import {} -> {}", input.display(), out.display()));
+                ensure_parent(&out).map_err(fail)?;
+                let (mesh, report) = stages::import::import(&input, &out).map_err(fail)?;
+                for line in stages::import::summary(&input, &mesh, &report) {
+                    log(&format!("      {line}"));
+                }
+            }
+            Stage::Export(s) => {
+                let (input, out) = (resolve(&base, &s.input), resolve(&base, &s.output));
+                log(&format!("[{index}/{n}] export {} -> {}", input.display(), out.display()));
+                ensure_parent(&out).map_err(fail)?;
+                let msg = stages::export::export(&input, &out, s.format).map_err(fail)?;
+                log(&format!("      {msg}"));
+            }
+        }
+    }
+    log("pipeline finished");
+    Ok(())
+}

@@ -1,0 +1,46 @@
+//! The pipeline stages as library calls. Each binary (`sc-import`, `sc-export`, …)
+//! and the pipeline runner call these same functions, so a stage behaves the same
+//! from the shell and from a pipeline YAML.
+
+pub mod export;
+pub mod gmsh;
+pub mod import;
+
+use crate::format::msh::MshError;
+use crate::format::stage::StageError;
+use crate::format::vtk::VtkError;
+
+/// Exit codes shared by every binary (ripgrep style): 0 success, 1 an I/O or
+/// environment failure, 2 bad input (file, mesh, setup), 3 a solve that did not
+/// converge (converged increments are kept on disk).
+pub mod exit_code {
+    pub const IO: u8 = 1;
+    pub const BAD_INPUT: u8 = 2;
+    pub const DIVERGED: u8 = 3;
+}
+
+/// Why a stage failed. Every variant carries the file (and line, element or set)
+/// at fault in its message.
+#[derive(Debug, thiserror::Error)]
+pub enum StageRunError {
+    #[error(transparent)]
+    Msh(#[from] MshError),
+    #[error(transparent)]
+    Stage(#[from] StageError),
+    #[error(transparent)]
+    Vtk(#[from] VtkError),
+    #[error("{0}")]
+    Usage(String),
+    #[error("{0}")]
+    Tool(String),
+}
+
+impl StageRunError {
+    /// The process exit code this error maps to.
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            Self::Stage(StageError::Io { .. }) | Self::Vtk(VtkError::Stage(StageError::Io { .. })) | Self::Tool(_) => exit_code::IO,
+            _ => exit_code::BAD_INPUT,
+        }
+    }
+}
