@@ -1,1 +1,5 @@
+//! Integration tests: the built binaries driven in temporary folders, with
+//! independent checks by Python's meshio and gmsh (see `test.sh`).
 
+mod cli;
+mod common;

@@ -1,0 +1,79 @@
+//! Every shipped pipeline runs (in a copy of the repository layout, so the tests
+//! never write into the checkout).
+
+use std::path::Path;
+
+use crate::common::*;
+
+fn copy_tree(from: &Path, to: &Path, sub: &str) {
+    let src = from.join(sub);
+    let dst = to.join(sub);
+    std::fs::create_dir_all(&dst).unwrap();
+    for e in std::fs::read_dir(&src).unwrap() {
+        let e = e.unwrap();
+        if e.file_type().unwrap().is_file() {
+            std::fs::copy(e.path(), dst.join(e.file_name())).unwrap();
+        }
+    }
+}
+
+fn staged_repo() -> tempfile::TempDir {
+    let dir = tempdir();
+    copy_tree(&repo(), dir.path(), "meshes");
+    copy_tree(&repo(), dir.path(), "pipelines");
+    dir
+}
+
+#[test]
+fn parisch_pipeline_imports_and_exports() {
+    let dir = staged_repo();
+    // Run from another folder: paths resolve against the YAML, not the cwd.
+    let o = run("sc-pipeline", &["pipelines/parisch.yaml"], dir.path());
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("[1/2] import") && err.contains("[2/2] export") && err.contains("pipeline finished"), "{err}");
+    let vtu = dir.path().join("pipelines/out/parisch.vtu");
+    let o = python_script("compare_msh_vtu.py", &[&dir.path().join("meshes/parisch.msh"), &vtu]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
+#[test]
+fn parisch_from_geo_pipeline_runs_gmsh() {
+    let dir = staged_repo();
+    let path = format!("{}:{}", gmsh().parent().unwrap().display(), std::env::var("PATH").unwrap_or_default());
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_sc-pipeline"))
+        .arg("pipelines/parisch-from-geo.yaml")
+        .current_dir(dir.path())
+        .env("PATH", path)
+        .env_remove("GMSH")
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(dir.path().join("pipelines/out/parisch-gmsh.vtu").is_file());
+}
+
+#[test]
+fn gmsh_stage_without_gmsh_says_so() {
+    let dir = staged_repo();
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_sc-pipeline"))
+        .arg("pipelines/parisch-from-geo.yaml")
+        .current_dir(dir.path())
+        .env("PATH", "/nonexistent")
+        .env_remove("GMSH")
+        .output()
+        .unwrap();
+    assert_fails(&o, 1, &["stage 1 (gmsh) failed", "gmsh is not installed"], &dir.path().join("pipelines/out/parisch-gmsh.msh"));
+}
+
+#[test]
+fn pipeline_stops_at_first_failing_stage() {
+    let dir = staged_repo();
+    std::fs::write(
+        dir.path().join("pipelines/broken.yaml"),
+        "version: 1\nstages:\n  - import: {input: ../meshes/missing.msh, output: out/a.scmesh}\n  - export: {input: out/a.scmesh, output: out/a.vtu}\n",
+    )
+    .unwrap();
+    let o = run("sc-pipeline", &["pipelines/broken.yaml"], dir.path());
+    assert_fails(&o, 1, &["stage 1 (import) failed", "missing.msh"], &dir.path().join("pipelines/out/a.scmesh"));
+    assert!(!stderr(&o).contains("[2/2]"), "second stage must not run");
+}
