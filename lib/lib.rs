@@ -24,4 +24,5 @@
 pub mod format;
 pub mod mesh;
 pub mod pipeline;
+pub mod post;
 pub mod stages;

@@ -4,5 +4,7 @@
 pub mod msh;
 pub mod pipeline;
 pub mod scmesh;
+pub mod scres;
+pub mod setup;
 pub mod stage;
 pub mod vtk;

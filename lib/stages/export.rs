@@ -4,7 +4,9 @@ use std::path::Path;
 
 use super::StageRunError;
 use crate::format::stage::{write_atomic_with, StageFile};
-use crate::format::{scmesh, vtk};
+use crate::format::scres::Results;
+use crate::format::{scmesh, scres, vtk};
+use crate::post::stresses;
 
 /// Output formats of `sc-export`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, serde::Deserialize)]
@@ -61,10 +63,53 @@ pub fn export(input: &Path, output: &Path, format: Option<ExportFormat>) -> Resu
             }
             other => Err(StageRunError::Usage(format!("{}: a '{other}' file cannot be exported as .vtu (supported: scmesh)", input.display()))),
         },
-        ExportFormat::Pvd => Err(StageRunError::Usage(format!(
-            "{}: a '{}' file holds no time series; .pvd is written for results files (use .vtu for a mesh)",
-            input.display(),
-            file.format
-        ))),
+        ExportFormat::Pvd => match file.format.as_str() {
+            scres::FORMAT => {
+                if file.major != scres::MAJOR {
+                    StageFile::read(input, Some((scres::FORMAT, scres::MAJOR)))?;
+                }
+                let results = Results::from_stage(&file)?;
+                write_results_pvd(&results, output)
+            }
+            other => Err(StageRunError::Usage(format!(
+                "{}: a '{other}' file holds no time series; .pvd is written for results files (use .vtu for a mesh)",
+                input.display()
+            ))),
+        },
     }
+}
+
+/// One `.vtu` per converged increment beside the `.pvd` (`<stem>_<k>.vtu`, k = 0 is
+/// the undeformed state), and the `.pvd` indexing them by load factor.
+pub fn write_results_pvd(results: &Results, output: &Path) -> Result<String, StageRunError> {
+    let stem = output.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "results".into());
+    let dir = output.parent().filter(|p| !p.as_os_str().is_empty()).map(Path::to_path_buf).unwrap_or_default();
+    let mesh = &results.mesh;
+    let mut entries = Vec::new();
+    let zero = scres::Increment {
+        info: scres::IncrementInfo { load_factor: 0.0, cutbacks: 0, iterations: vec![], reactions: vec![], seconds_output: 0.0 },
+        u: vec![[0.0; 3]; mesh.nodes.len()],
+        stress: vec![[[0.0; 9]; 8]; mesh.hexes.len()],
+    };
+    for (k, inc) in std::iter::once(&zero).chain(results.increments.iter()).enumerate() {
+        let name = format!("{stem}_{k}.vtu");
+        let mut g = vtk::mesh_grid(mesh);
+        g.point_data.push(vtk::Field::vector_f64("displacement", inc.u.iter().flatten().copied().collect()));
+        let elem = stresses::element_average(&inc.stress);
+        let nodal = stresses::nodal_average(mesh, &elem);
+        push_stress_fields(&mut g.point_data, &nodal);
+        push_stress_fields(&mut g.cell_data, &elem);
+        g.write_vtu(&dir.join(&name))?;
+        entries.push((inc.info.load_factor, name));
+    }
+    vtk::write_pvd(output, &entries)?;
+    Ok(format!("wrote {} ({} increments + the undeformed state)", output.display(), results.increments.len()))
+}
+
+fn push_stress_fields(fields: &mut Vec<vtk::Field>, s: &[stresses::Tensor9]) {
+    fields.push(vtk::Field::tensor_f64("stress", s.iter().flatten().copied().collect()));
+    fields.push(vtk::Field::scalar_f64("von_mises", s.iter().map(stresses::von_mises).collect()));
+    let p: Vec<[f64; 3]> = s.iter().map(stresses::principal).collect();
+    fields.push(vtk::Field::scalar_f64("principal_max", p.iter().map(|p| p[2]).collect()));
+    fields.push(vtk::Field::scalar_f64("principal_min", p.iter().map(|p| p[0]).collect()));
 }

@@ -1,0 +1,261 @@
+//! The solve setup (`sc-solve --setup solve.yaml`, or inline under a pipeline's
+//! `solve` stage), documented key by key in `docs/pipelines.md`.
+//!
+//! ```yaml
+//! formulation: total_lagrangian
+//! materials:
+//!   - {body: lower, model: neo_hookean, E: 1.0e4, nu: 0.3}
+//! constraints:
+//!   - {set: lower_base, fix: [x, y, z]}
+//!   - {set: top, displacement: {z: -1.0}}
+//! loads:
+//!   - {set: load_node, force: [0, 0, -100]}
+//!   - {face_set: upper_top, pressure: 2.0}
+//! increments: {count: 10}
+//! newton: {max_iterations: 25, residual_tolerance: 1.0e-8}
+//! ```
+
+use serde::Deserialize;
+
+/// Material models.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ModelName {
+    /// Compressible neo-Hookean, Ciarlet–Simo form (paper eq. 3.3 / 8.1).
+    NeoHookean,
+    /// Deviatoric/volumetric neo-Hookean of ANSYS and CalculiX (paper eq. 8.2 / 8.3).
+    NeoHookeanDevVol,
+    /// Small-strain linear elasticity (geometrically linear), for checks.
+    LinearElastic,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialSetup {
+    /// Body name (a gmsh physical volume).
+    pub body: String,
+    pub model: ModelName,
+    /// Young's modulus (give `E` and `nu`, or `lambda` and `mu`).
+    #[serde(rename = "E")]
+    pub e: Option<f64>,
+    pub nu: Option<f64>,
+    pub lambda: Option<f64>,
+    pub mu: Option<f64>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Formulation {
+    TotalLagrangian,
+    UpdatedLagrangian,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Component {
+    X,
+    Y,
+    Z,
+}
+
+impl Component {
+    pub fn index(self) -> usize {
+        match self {
+            Self::X => 0,
+            Self::Y => 1,
+            Self::Z => 2,
+        }
+    }
+}
+
+/// Prescribed displacement components, ramped with the load factor.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Components {
+    pub x: Option<f64>,
+    pub y: Option<f64>,
+    pub z: Option<f64>,
+}
+
+impl Components {
+    pub fn as_array(&self) -> [Option<f64>; 3] {
+        [self.x, self.y, self.z]
+    }
+}
+
+/// A Dirichlet condition on a node set: `fix` components to zero and/or prescribe
+/// `displacement` components (scaled by the load factor).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ConstraintSetup {
+    pub set: String,
+    #[serde(default)]
+    pub fix: Vec<Component>,
+    #[serde(default)]
+    pub displacement: Option<Components>,
+}
+
+/// A load: a force on a node set (total, spread evenly over its nodes, or
+/// `per_node`), or a follower pressure on a face set. Scaled by the load factor.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LoadSetup {
+    pub set: Option<String>,
+    pub force: Option<[f64; 3]>,
+    #[serde(default)]
+    pub per_node: bool,
+    pub face_set: Option<String>,
+    /// Follower pressure (positive pushes against the face's outward normal).
+    pub pressure: Option<f64>,
+}
+
+/// Load factors: `count` equal increments up to 1, or an explicit increasing list.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct IncrementSetup {
+    pub count: Option<u32>,
+    pub factors: Option<Vec<f64>>,
+    /// How many times an increment may be halved before the solve stops.
+    #[serde(default = "default_cutbacks")]
+    pub max_cutbacks: u32,
+}
+
+fn default_cutbacks() -> u32 {
+    5
+}
+
+impl Default for IncrementSetup {
+    fn default() -> Self {
+        Self { count: Some(1), factors: None, max_cutbacks: default_cutbacks() }
+    }
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NewtonSetup {
+    #[serde(default = "default_max_iterations")]
+    pub max_iterations: u32,
+    /// ‖R_free‖ ≤ tol · max(‖F_ext‖, ‖reactions‖, tiny).
+    #[serde(default = "default_residual_tol")]
+    pub residual_tolerance: f64,
+    /// |Δu · R| ≤ tol · (Δu₀ · R₀) of the increment's first iteration.
+    #[serde(default = "default_energy_tol")]
+    pub energy_tolerance: f64,
+}
+
+fn default_max_iterations() -> u32 {
+    25
+}
+fn default_residual_tol() -> f64 {
+    1e-8
+}
+fn default_energy_tol() -> f64 {
+    1e-16
+}
+
+impl Default for NewtonSetup {
+    fn default() -> Self {
+        Self { max_iterations: default_max_iterations(), residual_tolerance: default_residual_tol(), energy_tolerance: default_energy_tol() }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum LinearSolverChoice {
+    /// Cholesky while the tangent is symmetric (LDLᵀ if it is indefinite), LU otherwise.
+    #[default]
+    Auto,
+    Cholesky,
+    Ldlt,
+    Lu,
+}
+
+/// The whole setup.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SolveSetup {
+    #[serde(default = "default_formulation")]
+    pub formulation: Formulation,
+    pub materials: Vec<MaterialSetup>,
+    #[serde(default)]
+    pub constraints: Vec<ConstraintSetup>,
+    #[serde(default)]
+    pub loads: Vec<LoadSetup>,
+    #[serde(default)]
+    pub increments: IncrementSetup,
+    #[serde(default)]
+    pub newton: NewtonSetup,
+    #[serde(default)]
+    pub linear_solver: LinearSolverChoice,
+}
+
+fn default_formulation() -> Formulation {
+    Formulation::TotalLagrangian
+}
+
+/// A setup could not be read.
+#[derive(Debug, thiserror::Error)]
+#[error("{path}: {message}")]
+pub struct SetupError {
+    pub path: String,
+    pub message: String,
+}
+
+impl SolveSetup {
+    pub fn parse(path: &str, text: &str) -> Result<Self, SetupError> {
+        serde_yaml::from_str(text).map_err(|e| SetupError { path: path.into(), message: e.to_string() })
+    }
+
+    pub fn read(path: &std::path::Path) -> Result<Self, SetupError> {
+        let shown = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|e| SetupError { path: shown.clone(), message: format!("cannot read: {e}") })?;
+        Self::parse(&shown, &text)
+    }
+
+    /// The load factors of the converged increments to reach, increasing, ending at 1
+    /// (or at the list's last entry).
+    pub fn load_factors(&self, path: &str) -> Result<Vec<f64>, SetupError> {
+        let err = |m: String| SetupError { path: path.into(), message: m };
+        match (&self.increments.count, &self.increments.factors) {
+            (Some(_), Some(_)) => Err(err("increments: give `count` or `factors`, not both".into())),
+            (_, Some(f)) => {
+                if f.is_empty() || f.iter().any(|x| !x.is_finite() || *x <= 0.0) || f.windows(2).any(|w| w[1] <= w[0]) {
+                    Err(err(format!("increments.factors must be positive and strictly increasing, found {f:?}")))
+                } else {
+                    Ok(f.clone())
+                }
+            }
+            (Some(0), None) => Err(err("increments.count must be at least 1".into())),
+            (Some(n), None) => Ok((1..=*n).map(|i| i as f64 / *n as f64).collect()),
+            (None, None) => Ok(vec![1.0]),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn full_setup_parses() {
+        let y = "materials:\n  - {body: b, model: neo_hookean, E: 1.0e4, nu: 0.3}\nconstraints:\n  - {set: base, fix: [x, y, z]}\n  - {set: top, displacement: {z: -1.0}}\nloads:\n  - {set: p, force: [0, 0, -1]}\n  - {face_set: f, pressure: 2}\nincrements: {factors: [0.5, 1.0]}\nnewton: {max_iterations: 10}\nlinear_solver: lu\n";
+        let s = SolveSetup::parse("s.yaml", y).unwrap();
+        assert_eq!(s.load_factors("s").unwrap(), vec![0.5, 1.0]);
+        assert_eq!(s.linear_solver, LinearSolverChoice::Lu);
+        assert_eq!(s.constraints[1].displacement.as_ref().unwrap().z, Some(-1.0));
+    }
+
+    #[test]
+    fn unknown_key_and_model_are_named_with_line() {
+        let e = SolveSetup::parse("s.yaml", "materials:\n  - {body: b, model: neo_hookean, E: 1, nu: 0.3, rho: 2}\n").unwrap_err().to_string();
+        assert!(e.contains("rho") && e.contains("line 2"), "{e}");
+        let e = SolveSetup::parse("s.yaml", "materials:\n  - {body: b, model: mooney, E: 1, nu: 0.3}\n").unwrap_err().to_string();
+        assert!(e.contains("mooney") && e.contains("neo_hookean"), "{e}");
+    }
+
+    #[test]
+    fn count_gives_equal_steps() {
+        let s = SolveSetup::parse("s", "materials: []\nincrements: {count: 4}\n").unwrap();
+        assert_eq!(s.load_factors("s").unwrap(), vec![0.25, 0.5, 0.75, 1.0]);
+    }
+}

@@ -1,0 +1,2 @@
+//! Post-processing of converged states: stress measures and nodal fields.
+pub mod stresses;
