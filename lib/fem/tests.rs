@@ -97,6 +97,7 @@ macro_rules! element_derivative_tests {
                     );
                     let (_, k) = residual_tangent(&X, &to_u(&u0), &m, form);
                     let e = rel_err(k.as_slice(), fd.as_slice());
+                    eprintln!("{}: {e:.1e}", module_path!());
                     assert!(e < 1e-6, "{form:?}: rel. error {e:e}");
                 }
             }
@@ -110,6 +111,7 @@ macro_rules! element_derivative_tests {
                 for form in FORMS {
                     let (r, _) = residual_tangent(&X, &to_u(&u0), &m, form);
                     let e = rel_err(r.as_slice(), fd.as_slice());
+                    eprintln!("{}: {e:.1e}", module_path!());
                     assert!(e < 1e-6, "{form:?}: rel. error {e:e}");
                 }
             }
@@ -123,6 +125,7 @@ macro_rules! element_derivative_tests {
                 let (r_ul, k_ul) = residual_tangent(&X, &u, &m, Formulation::UpdatedLagrangian);
                 let er = rel_err(r_tl.as_slice(), r_ul.as_slice());
                 let ek = rel_err(k_tl.as_slice(), k_ul.as_slice());
+                eprintln!("TL/UL residual {er:.1e} tangent {ek:.1e}");
                 assert!(er < 1e-12 && ek < 1e-12, "residual {er:e}, tangent {ek:e}");
                 // The residual-only path gives the same vector.
                 let mut r = ElementVector::zeros();
@@ -145,6 +148,7 @@ macro_rules! element_derivative_tests {
                 let s_ex = m.stress(&F).unwrap();
                 for (q, sq) in s.iter().enumerate() {
                     let e = rel_err(sq.as_slice(), s_ex.as_slice());
+                    eprintln!("{}: {e:.1e}", module_path!());
                     assert!(e < 1e-12, "Gauss point {q}: {e:e}");
                 }
                 // Faces of the configuration the stress is integrated on.
@@ -163,6 +167,7 @@ macro_rules! element_derivative_tests {
                 for form in FORMS {
                     let (r, _) = residual_tangent(&X, &u, &m, form);
                     let e = rel_err(r.as_slice(), f_traction.as_slice());
+                    eprintln!("{}: {e:.1e}", module_path!());
                     assert!(e < 1e-12, "{form:?}: {e:e}");
                 }
             }
@@ -234,6 +239,7 @@ fn uniaxial_stress_closed_forms_on_distorted_hex() {
         let s = hex8_gauss_stresses(&X, &affine_u(&X, &F), &m).unwrap();
         for (q, sq) in s.iter().enumerate() {
             let e = rel_err(sq.as_slice(), s_ex.as_slice());
+            eprintln!("{}: {e:.1e}", module_path!());
             assert!(e < 1e-12, "{m:?} Gauss point {q}: rel. error {e:e}\n{sq}\nvs\n{s_ex}");
         }
     }
@@ -252,6 +258,7 @@ fn rigid_rotation_is_stress_free() {
     let u = X.map(|x| R * x - x + Vector3::new(1.0, 2.0, 3.0));
     for m in [MaterialModel::from(ciarlet_simo()), dev_vol().into()] {
         for s in hex8_gauss_stresses(&X, &u, &m).unwrap() {
+            eprintln!("rigid rotation |σ| = {:.1e}", s.norm());
             assert!(s.norm() < 1e-10 * MU, "{m:?}: |σ| = {:e}", s.norm());
         }
         for form in FORMS {
@@ -274,6 +281,7 @@ fn small_strain_limit_matches_linear_elasticity() {
             let (r, k) = residual_tangent(&X, &u, &m, form);
             let ek = rel_err(k.as_slice(), k_lin.as_slice());
             let er = rel_err(r.as_slice(), r_lin.as_slice());
+            eprintln!("small strain {m:?} {form:?}: tangent {ek:.1e}, residual {er:.1e}");
             assert!(
                 ek < 1e-5 && er < 1e-5,
                 "{m:?} {form:?}: tangent {ek:e}, residual {er:e}"
@@ -347,6 +355,7 @@ fn pressure_stiffness_is_derivative_of_force() {
     follower_pressure_force_stiffness(&warped_face(), p, &mut f, &mut k);
     assert_eq!(f, follower_pressure_force(&warped_face(), p));
     let e = rel_err(k.as_slice(), fd.as_slice());
+    eprintln!("{}: {e:.1e}", module_path!());
     assert!(e < 1e-6, "rel. error {e:e}");
     // One face: not symmetric.
     assert!((k - k.transpose()).norm() > 1e-3 * k.norm());

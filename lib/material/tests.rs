@@ -115,6 +115,7 @@ macro_rules! material_derivative_tests {
             fn stress_is_derivative_of_energy() {
                 for F in deformations() {
                     let e = check_stress_vs_energy(&$mat, &F);
+                    eprintln!("{}: {e:.1e}", module_path!());
                     assert!(e < 1e-6, "rel. error {e:e} at F = {F}");
                 }
             }
@@ -123,6 +124,7 @@ macro_rules! material_derivative_tests {
             fn spatial_tangent_is_derivative_of_stress() {
                 for F in deformations() {
                     let e = check_spatial_tangent_vs_stress(&$mat, &F);
+                    eprintln!("{}: {e:.1e}", module_path!());
                     assert!(e < 1e-6, "rel. error {e:e} at F = {F}");
                 }
             }
@@ -134,6 +136,7 @@ macro_rules! material_derivative_tests {
                 }
                 for F in deformations() {
                     let e = check_material_tangent_vs_stress(&$mat, &F);
+                    eprintln!("{}: {e:.1e}", module_path!());
                     assert!(e < 1e-6, "rel. error {e:e} at F = {F}");
                 }
             }
