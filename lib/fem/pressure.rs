@@ -8,10 +8,10 @@
 //! f_a = −∫ p N_a n da = −p Σ_q w_q N_a(ξ_q) (x_,ξ × x_,η)(ξ_q)   (2×2 Gauss).
 //!
 //! **Load stiffness.** With x_,ξ = Σ_b N_b,ξ x_b, a variation δx_b changes the area
-//! vector by N_b,ξ δx_b × x_,η + x_,ξ × N_b,η δx_b = (N_b,η [x_,ξ]_× − N_b,ξ [x_,η]_×) δx_b,
-//! with [v]_× w = v × w. Hence
+//! vector by N_b,ξ δx_b × x_,η + x_,ξ × N_b,η δx_b = (N_b,η \[x_,ξ\]_× − N_b,ξ \[x_,η\]_×) δx_b,
+//! with \[v\]_× w = v × w. Hence
 //!
-//! K_ab = ∂f_a/∂x_b = −p Σ_q w_q N_a (N_b,η [x_,ξ]_× − N_b,ξ [x_,η]_×),
+//! K_ab = ∂f_a/∂x_b = −p Σ_q w_q N_a (N_b,η \[x_,ξ\]_× − N_b,ξ \[x_,η\]_×),
 //!
 //! non-symmetric for one face (its skew part cancels only over a closed surface, or on
 //! a loaded boundary whose edges are fixed). As f is an *external* force, the Newton
