@@ -21,10 +21,12 @@
 //! | g_N, t_N, λ_N, ε_N | `g_n`, `t_n`, `lambda_n`, `eps_n` | 4.2–4.3 |
 //! | ξ̄^α, ā_α, ā_αβ, b̄_αβ | `xi`, `a_alpha`, `a_ab`, `b_ab` | 4.10–4.13 |
 
+pub mod assembly;
 pub mod fem;
 pub mod format;
 pub mod material;
 pub mod mesh;
 pub mod pipeline;
 pub mod post;
+pub mod solver;
 pub mod stages;

@@ -1,0 +1,504 @@
+//! Sparsity pattern of the reduced stiffness `K_ff`, built once, and the map from
+//! every element-matrix entry to its position in the values array.
+//!
+//! **Symbolic once, numeric many.** The pattern depends only on the connectivity
+//! (hexahedra plus contact node groups) and on which dofs are constrained. It is
+//! built once; every Newton iteration then refills the values by an index scatter
+//! (`values[slot[e][i + 24 j]] += k_e[(i, j)]`) with no search and no allocation, and
+//! the solver reuses its symbolic factorization. The pattern is rebuilt only when
+//! the contact groups change (a slave node finds new master control points), by
+//! calling [`Pattern::build`] again (or [`Pattern::with_groups`]).
+//!
+//! **Layout.** Compressed sparse columns over the free dofs, both triangles stored
+//! (LU needs the whole matrix; Cholesky reads the lower one), rows sorted in each
+//! column, as faer's [`SymbolicSparseColMat<usize>`]. Two free dofs are coupled
+//! when their nodes share a hexahedron or a contact group; all three components of
+//! coupled nodes are coupled (the 3×3 node blocks are stored whole).
+//!
+//! **Element slots.** For hexahedron `e`, `hex_slots(e)[i + 24 j]` (column-major,
+//! like nalgebra's `SMatrix<f64, 24, 24>`) is the index in the values array of the
+//! entry (row = local dof `i`, column = local dof `j`), local dof `3a + c` being
+//! component `c` of local node `a`; it is [`NO_SLOT`] when either dof is
+//! constrained. Contact groups ("elements with k nodes") have the same map of size
+//! `(3k)²` through [`Pattern::group_slots`].
+
+use faer::sparse::{SymbolicSparseColMat, SymbolicSparseColMatRef};
+use rayon::prelude::*;
+
+use super::dofs::{DofMap, DOFS_PER_NODE};
+
+/// Slot of an element-matrix entry that touches a constrained dof (dropped).
+pub const NO_SLOT: u32 = u32::MAX;
+/// Dofs of a hex8 element.
+pub const HEX_DOFS: usize = 8 * DOFS_PER_NODE;
+/// Entries of a hex8 element matrix.
+pub const HEX_ENTRIES: usize = HEX_DOFS * HEX_DOFS;
+
+/// Errors building a [`Pattern`].
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum PatternError {
+    #[error("hexahedron {element} refers to node {node}, but the dof map has {n_nodes} nodes")]
+    HexNodeOutOfRange { element: usize, node: u32, n_nodes: usize },
+    #[error("contact group {group} refers to node {node}, but the dof map has {n_nodes} nodes")]
+    GroupNodeOutOfRange { group: usize, node: u32, n_nodes: usize },
+    #[error("the pattern has {nnz} entries, more than the 32-bit slot numbering allows")]
+    TooManyEntries { nnz: usize },
+}
+
+/// A list of node groups, each coupled all-to-all (a contact element: one slave
+/// node and the master control points it sees), stored flat.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct NodeGroups {
+    offsets: Vec<usize>,
+    nodes: Vec<u32>,
+}
+
+impl NodeGroups {
+    pub fn new() -> Self {
+        Self { offsets: vec![0], nodes: Vec::new() }
+    }
+
+    /// Appends one group.
+    pub fn push(&mut self, nodes: &[u32]) {
+        if self.offsets.is_empty() {
+            self.offsets.push(0);
+        }
+        self.nodes.extend_from_slice(nodes);
+        self.offsets.push(self.nodes.len());
+    }
+
+    pub fn len(&self) -> usize {
+        self.offsets.len().saturating_sub(1)
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Nodes of group `g`.
+    pub fn group(&self, g: usize) -> &[u32] {
+        &self.nodes[self.offsets[g]..self.offsets[g + 1]]
+    }
+
+    pub fn iter(&self) -> impl Iterator<Item = &[u32]> + Clone + '_ {
+        (0..self.len()).map(move |g| self.group(g))
+    }
+}
+
+impl<'a> FromIterator<&'a [u32]> for NodeGroups {
+    fn from_iter<T: IntoIterator<Item = &'a [u32]>>(iter: T) -> Self {
+        let mut g = NodeGroups::new();
+        for nodes in iter {
+            g.push(nodes);
+        }
+        g
+    }
+}
+
+/// Sparsity pattern of `K_ff` plus the element → value-slot maps.
+#[derive(Debug, Clone)]
+pub struct Pattern {
+    dofs: DofMap,
+    hexes: Vec<[u32; 8]>,
+    groups: NodeGroups,
+    symbolic: SymbolicSparseColMat<usize>,
+    /// `n_hex · 576`, column-major per element.
+    hex_slots: Vec<u32>,
+    /// `group_slots[group_slot_offsets[g]..group_slot_offsets[g + 1]]`, `(3k)²` each.
+    group_slot_offsets: Vec<usize>,
+    group_slots: Vec<u32>,
+}
+
+impl Pattern {
+    /// Builds the pattern from hexahedra and contact node groups.
+    pub fn build(dofs: DofMap, hexes: &[[u32; 8]], groups: NodeGroups) -> Result<Self, PatternError> {
+        let n_nodes = dofs.n_nodes();
+        for (e, hex) in hexes.iter().enumerate() {
+            if let Some(&node) = hex.iter().find(|&&a| a as usize >= n_nodes) {
+                return Err(PatternError::HexNodeOutOfRange { element: e, node, n_nodes });
+            }
+        }
+        for (g, nodes) in groups.iter().enumerate() {
+            if let Some(&node) = nodes.iter().find(|&&a| a as usize >= n_nodes) {
+                return Err(PatternError::GroupNodeOutOfRange { group: g, node, n_nodes });
+            }
+        }
+
+        // node -> hexes and node -> groups (CSR, by counting).
+        let node_hexes = invert(n_nodes, hexes.iter().map(|h| &h[..]));
+        let node_groups = invert(n_nodes, groups.iter());
+
+        // Sorted, unique neighbour nodes of every node (itself included if it is
+        // in any element).
+        let neighbours: Vec<Vec<u32>> = (0..n_nodes)
+            .into_par_iter()
+            .map(|a| {
+                let mut nb: Vec<u32> = Vec::new();
+                for &e in node_hexes.of(a) {
+                    nb.extend_from_slice(&hexes[e as usize]);
+                }
+                for &g in node_groups.of(a) {
+                    nb.extend_from_slice(groups.group(g as usize));
+                }
+                nb.sort_unstable();
+                nb.dedup();
+                nb
+            })
+            .collect();
+
+        // Free rows of the columns of node a: free dofs of its neighbours, in
+        // increasing order (free numbering is monotone in the global dof).
+        let free_rows_of_node = |a: usize, out: &mut Vec<usize>| {
+            out.clear();
+            for &b in &neighbours[a] {
+                for c in 0..DOFS_PER_NODE {
+                    if let Some(f) = dofs.free(DOFS_PER_NODE * b as usize + c) {
+                        out.push(f);
+                    }
+                }
+            }
+        };
+
+        let n_free = dofs.n_free();
+        let mut col_ptr = Vec::with_capacity(n_free + 1);
+        col_ptr.push(0usize);
+        let mut row_idx: Vec<usize> = Vec::new();
+        let mut rows = Vec::new();
+        for a in 0..n_nodes {
+            let n_free_comps =
+                (0..DOFS_PER_NODE).filter(|&c| !dofs.is_constrained(DOFS_PER_NODE * a + c)).count();
+            if n_free_comps == 0 {
+                continue;
+            }
+            free_rows_of_node(a, &mut rows);
+            for c in 0..DOFS_PER_NODE {
+                if !dofs.is_constrained(DOFS_PER_NODE * a + c) {
+                    row_idx.extend_from_slice(&rows);
+                    col_ptr.push(row_idx.len());
+                }
+            }
+        }
+        debug_assert_eq!(col_ptr.len(), n_free + 1);
+        let nnz = row_idx.len();
+        if nnz >= NO_SLOT as usize {
+            return Err(PatternError::TooManyEntries { nnz });
+        }
+
+        // Slot of (row dof, column dof) by binary search in the column.
+        let slot_of = |row: Option<usize>, col: Option<usize>| -> u32 {
+            match (row, col) {
+                (Some(r), Some(c)) => {
+                    let (lo, hi) = (col_ptr[c], col_ptr[c + 1]);
+                    match row_idx[lo..hi].binary_search(&r) {
+                        Ok(k) => (lo + k) as u32,
+                        Err(_) => unreachable!("coupled dofs are in the pattern by construction"),
+                    }
+                }
+                _ => NO_SLOT,
+            }
+        };
+        let element_slots = |nodes: &[u32], out: &mut [u32]| {
+            let nd = DOFS_PER_NODE * nodes.len();
+            let free = |i: usize| dofs.free(DOFS_PER_NODE * nodes[i / DOFS_PER_NODE] as usize + i % DOFS_PER_NODE);
+            for j in 0..nd {
+                let fj = free(j);
+                for i in 0..nd {
+                    out[i + nd * j] = slot_of(free(i), fj);
+                }
+            }
+        };
+
+        let mut hex_slots = vec![NO_SLOT; hexes.len() * HEX_ENTRIES];
+        hex_slots
+            .par_chunks_mut(HEX_ENTRIES)
+            .zip(hexes.par_iter())
+            .for_each(|(out, hex)| element_slots(hex, out));
+
+        let mut group_slot_offsets = Vec::with_capacity(groups.len() + 1);
+        group_slot_offsets.push(0usize);
+        for nodes in groups.iter() {
+            let nd = DOFS_PER_NODE * nodes.len();
+            group_slot_offsets.push(group_slot_offsets[group_slot_offsets.len() - 1] + nd * nd);
+        }
+        let mut group_slots = vec![NO_SLOT; group_slot_offsets[groups.len()]];
+        for (g, nodes) in groups.iter().enumerate() {
+            element_slots(nodes, &mut group_slots[group_slot_offsets[g]..group_slot_offsets[g + 1]]);
+        }
+
+        let symbolic = SymbolicSparseColMat::new_checked(n_free, n_free, col_ptr, None, row_idx);
+        Ok(Self {
+            dofs,
+            hexes: hexes.to_vec(),
+            groups,
+            symbolic,
+            hex_slots,
+            group_slot_offsets,
+            group_slots,
+        })
+    }
+
+    /// The same dofs and hexahedra with new contact groups (the pattern and every
+    /// slot map are rebuilt; the solver must then `analyse` again).
+    pub fn with_groups(&self, groups: NodeGroups) -> Result<Self, PatternError> {
+        Self::build(self.dofs.clone(), &self.hexes, groups)
+    }
+
+    pub fn dofs(&self) -> &DofMap {
+        &self.dofs
+    }
+
+    pub fn hexes(&self) -> &[[u32; 8]] {
+        &self.hexes
+    }
+
+    pub fn groups(&self) -> &NodeGroups {
+        &self.groups
+    }
+
+    /// The CSC pattern of `K_ff` (both triangles, sorted rows).
+    pub fn symbolic(&self) -> SymbolicSparseColMatRef<'_, usize> {
+        self.symbolic.as_ref()
+    }
+
+    /// Owned CSC pattern (cheap to clone for a solver that keeps it).
+    pub fn symbolic_owned(&self) -> &SymbolicSparseColMat<usize> {
+        &self.symbolic
+    }
+
+    /// Order of `K_ff`.
+    pub fn n_free(&self) -> usize {
+        self.dofs.n_free()
+    }
+
+    /// Stored entries (length of the values array).
+    pub fn nnz(&self) -> usize {
+        self.symbolic.row_idx().len()
+    }
+
+    /// Column pointers (length `n_free + 1`).
+    pub fn col_ptr(&self) -> &[usize] {
+        self.symbolic.col_ptr()
+    }
+
+    /// Row indices (length `nnz`).
+    pub fn row_idx(&self) -> &[usize] {
+        self.symbolic.row_idx()
+    }
+
+    /// Value slots of hexahedron `e`: 576 entries, column-major, [`NO_SLOT`] for
+    /// entries touching a constrained dof.
+    pub fn hex_slots(&self, e: usize) -> &[u32] {
+        &self.hex_slots[e * HEX_ENTRIES..(e + 1) * HEX_ENTRIES]
+    }
+
+    /// Value slots of contact group `g`: `(3k)²` entries, column-major.
+    pub fn group_slots(&self, g: usize) -> &[u32] {
+        &self.group_slots[self.group_slot_offsets[g]..self.group_slot_offsets[g + 1]]
+    }
+}
+
+/// Node → items incidence in CSR form.
+struct Incidence {
+    ptr: Vec<usize>,
+    items: Vec<u32>,
+}
+
+impl Incidence {
+    fn of(&self, a: usize) -> &[u32] {
+        &self.items[self.ptr[a]..self.ptr[a + 1]]
+    }
+}
+
+/// Inverts item → nodes into node → items (items in increasing order).
+fn invert<'a>(n_nodes: usize, items: impl Iterator<Item = &'a [u32]> + Clone) -> Incidence {
+    let mut ptr = vec![0usize; n_nodes + 1];
+    for nodes in items.clone() {
+        for &a in nodes {
+            ptr[a as usize + 1] += 1;
+        }
+    }
+    for a in 0..n_nodes {
+        ptr[a + 1] += ptr[a];
+    }
+    let mut fill = ptr.clone();
+    let mut out = vec![0u32; ptr[n_nodes]];
+    for (e, nodes) in items.enumerate() {
+        for &a in nodes {
+            out[fill[a as usize]] = e as u32;
+            fill[a as usize] += 1;
+        }
+    }
+    Incidence { ptr, items: out }
+}
+
+/// Structured `nx × ny × nz` hex grid on the unit-spaced lattice, for tests and
+/// benchmarks: nodes `(i, j, k)` numbered `i + (nx+1)(j + (ny+1) k)`, hexes in
+/// VTK order.
+pub fn structured_hex_grid(nx: usize, ny: usize, nz: usize) -> (Vec<[f64; 3]>, Vec<[u32; 8]>) {
+    let id = |i: usize, j: usize, k: usize| (i + (nx + 1) * (j + (ny + 1) * k)) as u32;
+    let mut nodes = Vec::with_capacity((nx + 1) * (ny + 1) * (nz + 1));
+    for k in 0..=nz {
+        for j in 0..=ny {
+            for i in 0..=nx {
+                nodes.push([i as f64, j as f64, k as f64]);
+            }
+        }
+    }
+    let mut hexes = Vec::with_capacity(nx * ny * nz);
+    for k in 0..nz {
+        for j in 0..ny {
+            for i in 0..nx {
+                hexes.push([
+                    id(i, j, k),
+                    id(i + 1, j, k),
+                    id(i + 1, j + 1, k),
+                    id(i, j + 1, k),
+                    id(i, j, k + 1),
+                    id(i + 1, j, k + 1),
+                    id(i + 1, j + 1, k + 1),
+                    id(i, j + 1, k + 1),
+                ]);
+            }
+        }
+    }
+    (nodes, hexes)
+}
+
+#[cfg(test)]
+#[allow(clippy::needless_range_loop)]
+mod tests {
+    use super::*;
+
+    /// Dense brute force: coupled[r][c] for free dofs.
+    fn dense_pattern(dofs: &DofMap, elements: &[Vec<u32>]) -> Vec<Vec<bool>> {
+        let n = dofs.n_free();
+        let mut m = vec![vec![false; n]; n];
+        for nodes in elements {
+            for &a in nodes {
+                for &b in nodes {
+                    for i in 0..3 {
+                        for j in 0..3 {
+                            if let (Some(r), Some(c)) =
+                                (dofs.free(3 * a as usize + i), dofs.free(3 * b as usize + j))
+                            {
+                                m[r][c] = true;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        m
+    }
+
+    fn to_dense(p: &Pattern) -> Vec<Vec<bool>> {
+        let n = p.n_free();
+        let mut m = vec![vec![false; n]; n];
+        for c in 0..n {
+            let rows = &p.row_idx()[p.col_ptr()[c]..p.col_ptr()[c + 1]];
+            assert!(rows.windows(2).all(|w| w[0] < w[1]), "rows sorted and unique");
+            for &r in rows {
+                m[r][c] = true;
+            }
+        }
+        m
+    }
+
+    fn grid_with_constraints() -> (Vec<[u32; 8]>, DofMap) {
+        let (nodes, hexes) = structured_hex_grid(3, 2, 2);
+        // Clamp x = 0 fully, and u_z on the node at (3, 2, 2).
+        let mut mask = vec![false; 3 * nodes.len()];
+        for (a, x) in nodes.iter().enumerate() {
+            if x[0] == 0.0 {
+                mask[3 * a..3 * a + 3].fill(true);
+            }
+            if *x == [3.0, 2.0, 2.0] {
+                mask[3 * a + 2] = true;
+            }
+        }
+        (hexes, DofMap::from_constrained_mask(&mask).unwrap())
+    }
+
+    #[test]
+    fn pattern_matches_dense_brute_force_on_3x2x2_grid() {
+        let (hexes, dofs) = grid_with_constraints();
+        assert_eq!(dofs.n_nodes(), 4 * 3 * 3);
+        assert_eq!(dofs.n_free(), 3 * 36 - 3 * 9 - 1);
+        let p = Pattern::build(dofs.clone(), &hexes, NodeGroups::new()).unwrap();
+        let elements: Vec<Vec<u32>> = hexes.iter().map(|h| h.to_vec()).collect();
+        let dense = dense_pattern(&dofs, &elements);
+        assert_eq!(to_dense(&p), dense);
+        let nnz_dense = dense.iter().flatten().filter(|&&b| b).count();
+        assert_eq!(p.nnz(), nnz_dense);
+
+        // Every slot points at the entry it claims to.
+        for (e, hex) in hexes.iter().enumerate() {
+            let slots = p.hex_slots(e);
+            for j in 0..24 {
+                for i in 0..24 {
+                    let gi = 3 * hex[i / 3] as usize + i % 3;
+                    let gj = 3 * hex[j / 3] as usize + j % 3;
+                    let s = slots[i + 24 * j];
+                    match (dofs.free(gi), dofs.free(gj)) {
+                        (Some(r), Some(c)) => {
+                            let s = s as usize;
+                            assert!(p.col_ptr()[c] <= s && s < p.col_ptr()[c + 1]);
+                            assert_eq!(p.row_idx()[s], r);
+                        }
+                        _ => assert_eq!(s, NO_SLOT),
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn contact_groups_add_their_couplings() {
+        let (hexes, dofs) = grid_with_constraints();
+        let without = Pattern::build(dofs.clone(), &hexes, NodeGroups::new()).unwrap();
+        // Node 3 (x=3,y=0,z=0) with far nodes 35 (3,2,2) and 28 (0,1,2: clamped) and 17.
+        let groups: NodeGroups = [&[3u32, 35, 28, 17][..], &[5, 30][..]].into_iter().collect();
+        let p = without.with_groups(groups.clone()).unwrap();
+        let mut elements: Vec<Vec<u32>> = hexes.iter().map(|h| h.to_vec()).collect();
+        elements.extend(groups.iter().map(|g| g.to_vec()));
+        let dense = dense_pattern(&dofs, &elements);
+        assert_eq!(to_dense(&p), dense);
+
+        // New couplings: u_x(3) with u_y(35) (new), u_x(3) with u_z(35) constrained.
+        let f = |a: usize, c: usize| dofs.free(3 * a + c);
+        let d = to_dense(&without);
+        let (r, c) = (f(35, 1).unwrap(), f(3, 0).unwrap());
+        assert!(!d[r][c] && dense[r][c]);
+        assert!(f(35, 2).is_none() && f(28, 0).is_none());
+        // 2 new node pairs (3,35), (3,17), (35,17) are new; (17, 35) far apart too.
+        assert_eq!(p.nnz() - without.nnz(), dense.iter().flatten().filter(|&&b| b).count() - d.iter().flatten().filter(|&&b| b).count());
+        assert!(p.nnz() > without.nnz());
+
+        // Group slots point at the right entries.
+        for (g, nodes) in groups.iter().enumerate() {
+            let nd = 3 * nodes.len();
+            let slots = p.group_slots(g);
+            assert_eq!(slots.len(), nd * nd);
+            for j in 0..nd {
+                for i in 0..nd {
+                    let s = slots[i + nd * j];
+                    match (f(nodes[i / 3] as usize, i % 3), f(nodes[j / 3] as usize, j % 3)) {
+                        (Some(r), Some(c)) => {
+                            let s = s as usize;
+                            assert!(p.col_ptr()[c] <= s && s < p.col_ptr()[c + 1]);
+                            assert_eq!(p.row_idx()[s], r);
+                        }
+                        _ => assert_eq!(s, NO_SLOT),
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn bad_node_index_is_an_error() {
+        let dofs = DofMap::all_free(8).unwrap();
+        let err = Pattern::build(dofs, &[[0, 1, 2, 3, 4, 5, 6, 8]], NodeGroups::new()).unwrap_err();
+        assert_eq!(err, PatternError::HexNodeOutOfRange { element: 0, node: 8, n_nodes: 8 });
+    }
+}
