@@ -36,18 +36,21 @@ fn same_orientation(face: [u32; 4], quad: [u32; 4]) -> Option<bool> {
     }
 }
 
-/// Node → hexahedra incidence in compressed rows.
+/// Node → hexahedra incidence in compressed rows, for the nodes in `wanted` only
+/// (the first node of each quad is enough to find its hexahedra).
 struct Incidence {
     start: Vec<usize>,
     hexes: Vec<u32>,
 }
 
 impl Incidence {
-    fn new(n_nodes: usize, hexes: &[[u32; 8]]) -> Self {
+    fn new(n_nodes: usize, hexes: &[[u32; 8]], wanted: &[bool]) -> Self {
         let mut start = vec![0usize; n_nodes + 1];
         for h in hexes {
             for &n in h {
-                start[n as usize + 1] += 1;
+                if wanted[n as usize] {
+                    start[n as usize + 1] += 1;
+                }
             }
         }
         for i in 0..n_nodes {
@@ -57,8 +60,10 @@ impl Incidence {
         let mut list = vec![0u32; start[n_nodes]];
         for (e, h) in hexes.iter().enumerate() {
             for &n in h {
-                list[fill[n as usize]] = e as u32;
-                fill[n as usize] += 1;
+                if wanted[n as usize] {
+                    list[fill[n as usize]] = e as u32;
+                    fill[n as usize] += 1;
+                }
             }
         }
         Self { start, hexes: list }
@@ -78,7 +83,7 @@ pub(super) fn build(
     mut warnings: Vec<String>,
 ) -> Result<(Mesh, ImportReport), MshError> {
     let file = cur.file;
-    let Elements { hexes, hex_tags, hex_volume, flipped, groups, warnings: element_warnings, .. } = elements;
+    let Elements { mut hexes, hex_tags, hex_volume, flipped, groups, warnings: element_warnings, .. } = elements;
     warnings.extend(element_warnings);
     if hexes.is_empty() {
         return Err(MshError::NoHexes { file: file.to_string() });
@@ -110,9 +115,15 @@ pub(super) fn build(
     }
 
     // Bodies: one per physical volume holding hexahedra, by tag; unnamed last.
-    let mut volume_tags: Vec<i32> = hex_volume.clone();
+    let mut volume_tags: Vec<i32> = Vec::new();
+    let mut last = None;
+    for &v in &hex_volume {
+        if last != Some(v) && !volume_tags.contains(&v) {
+            volume_tags.push(v);
+        }
+        last = Some(v);
+    }
     volume_tags.sort_unstable();
-    volume_tags.dedup();
     if volume_tags.first() == Some(&0) {
         volume_tags.remove(0);
         volume_tags.push(0);
@@ -144,8 +155,17 @@ pub(super) fn build(
             ));
         }
     }
-    let body_index: HashMap<i32, u32> = volume_tags.iter().enumerate().map(|(i, &t)| (t, i as u32)).collect();
-    let hex_body: Vec<u32> = hex_volume.iter().map(|v| body_index.get(v).copied().unwrap_or(0)).collect();
+    let body_of = |v: i32| volume_tags.iter().position(|&t| t == v).unwrap_or(0) as u32;
+    let mut last = (i32::MIN, 0u32);
+    let hex_body: Vec<u32> = hex_volume
+        .iter()
+        .map(|&v| {
+            if v != last.0 {
+                last = (v, body_of(v));
+            }
+            last.1
+        })
+        .collect();
 
     // Face sets (before compaction: quads and hexes share the file's node indices).
     let n_old = nodes.tags.len();
@@ -162,7 +182,15 @@ pub(super) fn build(
             let type_name = element_type(number).map_or_else(|| format!("type {number}"), |t| t.describe());
             return Err(MshError::NonQuadFace { at: cur.at(offset), group: name, element, type_name, type_number: number });
         }
-        let inc = incidence.get_or_insert_with(|| Incidence::new(n_old, &hexes));
+        let inc = incidence.get_or_insert_with(|| {
+            let mut wanted = vec![false; n_old];
+            for g in groups.iter().filter(|g| g.dim == 2) {
+                for q in &g.quads {
+                    wanted[q.nodes[0] as usize] = true;
+                }
+            }
+            Incidence::new(n_old, &hexes, &wanted)
+        });
         let mut faces = Vec::with_capacity(group.quads.len());
         let mut quad_tags = Vec::with_capacity(group.quads.len());
         let mut interior = 0usize;
@@ -235,7 +263,6 @@ pub(super) fn build(
             node_tags.push(nodes.tags[i]);
         }
     }
-    let hexes: Vec<[u32; 8]> = hexes.iter().map(|h| h.map(|n| new_index[n as usize])).collect();
     if !dropped_nodes.is_empty() {
         warnings.push(format!("{} nodes used by no hexahedron were dropped", dropped_nodes.len()));
     }
@@ -249,7 +276,8 @@ pub(super) fn build(
         let mut set = Vec::new();
         let mut left_out = 0usize;
         if let Some(g) = group_of.get(&(dim, tag)) {
-            for &n in &g.nodes {
+            let hex_nodes = g.hexes.iter().flat_map(|&e| hexes[e as usize]);
+            for n in g.nodes.iter().copied().chain(hex_nodes) {
                 if stamp[n as usize] != mark {
                     stamp[n as usize] = mark;
                     match new_index[n as usize] {
@@ -269,6 +297,12 @@ pub(super) fn build(
             warnings.push(format!("node set `{name}` ({}) is empty", describe_group(dim, tag)));
         }
         node_sets.push(NodeSet { name, physical_tag: tag, dim, nodes: set });
+    }
+
+    for h in &mut hexes {
+        for n in h.iter_mut() {
+            *n = new_index[*n as usize];
+        }
     }
 
     if !flipped.is_empty() {

@@ -221,6 +221,33 @@ impl<'a> Cursor<'a> {
         Ok(if self.big_endian { f64::from_be_bytes(b) } else { f64::from_le_bytes(b) })
     }
 
+    /// Decode one binary `size_t` from the start of `b` (at least `self.size_t` bytes).
+    #[inline]
+    pub fn decode_size_t(&self, b: &[u8]) -> u64 {
+        if self.size_t == 4 {
+            let w = [b[0], b[1], b[2], b[3]];
+            u64::from(if self.big_endian { u32::from_be_bytes(w) } else { u32::from_le_bytes(w) })
+        } else {
+            let w = [b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7]];
+            if self.big_endian {
+                u64::from_be_bytes(w)
+            } else {
+                u64::from_le_bytes(w)
+            }
+        }
+    }
+
+    /// Decode one binary `double` from the start of `b` (at least 8 bytes).
+    #[inline]
+    pub fn decode_f64(&self, b: &[u8]) -> f64 {
+        let w = [b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7]];
+        if self.big_endian {
+            f64::from_be_bytes(w)
+        } else {
+            f64::from_le_bytes(w)
+        }
+    }
+
     /// An `int` of the spec: binary i32, or an ASCII integer in i32's range.
     pub fn int(&mut self, what: &str) -> Result<i32, MshError> {
         if self.binary {

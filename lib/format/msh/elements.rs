@@ -52,8 +52,10 @@ pub(super) struct Quad {
 pub(super) struct Group {
     pub dim: u8,
     pub tag: i32,
-    /// Node indices of all its elements, with repeats.
+    /// Node indices of its elements other than hexahedra, with repeats.
     pub nodes: Vec<u32>,
+    /// Its hexahedra (indices into [`Elements::hexes`]).
+    pub hexes: Vec<u32>,
     /// Its quads (physical surfaces only).
     pub quads: Vec<Quad>,
     /// First element of a physical surface that is not a 4-node quad: (tag, type, offset).
@@ -80,6 +82,8 @@ pub(super) struct Elements {
     pub flipped: Vec<u64>,
     pub groups: Vec<Group>,
     group_index: HashMap<(u8, i32), usize>,
+    /// The group looked up last: consecutive elements share their groups.
+    last_group: Option<((u8, i32), usize)>,
     /// Volume elements other than hex8: type → (count, offset of the first).
     unsupported: BTreeMap<i32, (u64, usize)>,
     /// MSH 2.2 only: sorted nodes → hexahedron, to keep a hexahedron written
@@ -94,11 +98,25 @@ pub(super) struct Elements {
 
 impl Elements {
     fn group(&mut self, dim: u8, tag: i32) -> &mut Group {
-        let n = self.groups.len();
-        let i = *self.group_index.entry((dim, tag)).or_insert(n);
-        if i == n {
-            self.groups.push(Group { dim, tag, nodes: Vec::new(), quads: Vec::new(), non_quad: None });
-        }
+        let i = match self.last_group {
+            Some((key, i)) if key == (dim, tag) => i,
+            _ => {
+                let n = self.groups.len();
+                let i = *self.group_index.entry((dim, tag)).or_insert(n);
+                if i == n {
+                    self.groups.push(Group {
+                        dim,
+                        tag,
+                        nodes: Vec::new(),
+                        hexes: Vec::new(),
+                        quads: Vec::new(),
+                        non_quad: None,
+                    });
+                }
+                self.last_group = Some(((dim, tag), i));
+                i
+            }
+        };
         &mut self.groups[i]
     }
 
@@ -145,27 +163,34 @@ impl Elements {
                     return Err(MshError::TwistedElement { at: cur.at(offset), element: tag, jacobians });
                 }
             }
-            let mut keep = true;
+            let mut index = self.hexes.len() as u32;
             if let Some(seen) = &mut self.seen {
                 let mut key = hex;
                 key.sort_unstable();
                 match seen.entry(key) {
                     Entry::Occupied(e) => {
-                        keep = false;
+                        index = *e.get();
                         self.repeated.0 += 1;
-                        let first = self.hex_tags[*e.get() as usize];
+                        let first = self.hex_tags[index as usize];
                         self.repeated.1.get_or_insert((tag, first));
                     }
                     Entry::Vacant(v) => {
-                        v.insert(self.hexes.len() as u32);
+                        v.insert(index);
                     }
                 }
             }
-            if keep {
+            if index as usize == self.hexes.len() {
                 self.hexes.push(hex);
                 self.hex_tags.push(tag);
                 self.hex_volume.push(physicals.first().copied().unwrap_or(0));
             }
+            for &p in physicals {
+                let g = self.group(dim, p);
+                if g.hexes.last() != Some(&index) {
+                    g.hexes.push(index);
+                }
+            }
+            return Ok(());
         } else if ty.dim == 3 {
             let e = self.unsupported.entry(ty.number).or_insert((0, offset));
             e.0 += 1;
@@ -361,11 +386,35 @@ fn parse_v4(
                 physicals[0]
             ));
         }
-        for _ in 0..in_block {
-            let offset = cur.pos;
-            let tag = cur.size_t("an element tag")?;
-            out.read_nodes(cur, nodes, &ty, tag, offset, false)?;
-            out.add(cur, nodes, Element { offset, tag, ty }, dim, &physicals)?;
+        if cur.binary {
+            // The block is `in_block × (1 + nodes)` size_t: take it whole.
+            let width = cur.size_t;
+            let record = (1 + ty.nodes) * width;
+            let start = cur.pos;
+            let bytes = usize::try_from(in_block)
+                .ok()
+                .and_then(|n| n.checked_mul(record))
+                .filter(|&b| b <= cur.bytes.len() - start)
+                .ok_or_else(|| cur.truncated())?;
+            let block = cur.take(bytes)?;
+            for (k, rec) in block.chunks_exact(record).enumerate() {
+                let offset = start + k * record;
+                let tag = cur.decode_size_t(rec);
+                out.buf.clear();
+                for word in rec[width..].chunks_exact(width) {
+                    let node = cur.decode_size_t(word);
+                    let index = nodes.map.get(node).ok_or_else(|| MshError::UnknownNode { at: cur.at(offset), element: tag, node })?;
+                    out.buf.push(index);
+                }
+                out.add(cur, nodes, Element { offset, tag, ty }, dim, &physicals)?;
+            }
+        } else {
+            for _ in 0..in_block {
+                let offset = cur.pos;
+                let tag = cur.size_t("an element tag")?;
+                out.read_nodes(cur, nodes, &ty, tag, offset, false)?;
+                out.add(cur, nodes, Element { offset, tag, ty }, dim, &physicals)?;
+            }
         }
         read += in_block;
     }

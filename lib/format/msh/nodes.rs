@@ -147,6 +147,10 @@ fn parse_v4(cur: &mut Cursor) -> Result<TagsAndCoords, MshError> {
                 ))
             }
         };
+        if cur.binary {
+            read_v4_binary_block(cur, n, 3 + extra, &mut tags, &mut coords)?;
+            continue;
+        }
         let first = tags.len();
         for _ in 0..n {
             tags.push(cur.size_t("a node tag")?);
@@ -168,6 +172,35 @@ fn parse_v4(cur: &mut Cursor) -> Result<TagsAndCoords, MshError> {
         });
     }
     Ok((tags, coords))
+}
+
+/// A binary 4.1 node block, read as two slices: `n` size_t tags, then `n ×
+/// values` doubles (x y z and any parametric coordinates).
+fn read_v4_binary_block(
+    cur: &mut Cursor,
+    n: u64,
+    values: usize,
+    tags: &mut Vec<u64>,
+    coords: &mut Vec<Vec3>,
+) -> Result<(), MshError> {
+    let remaining = cur.bytes.len() - cur.pos;
+    let n = usize::try_from(n)
+        .ok()
+        .filter(|&n| n.checked_mul(cur.size_t + 8 * values).is_some_and(|b| b <= remaining))
+        .ok_or_else(|| cur.truncated())?;
+    let tag_bytes = cur.take(n * cur.size_t)?;
+    tags.extend(tag_bytes.chunks_exact(cur.size_t).map(|w| cur.decode_size_t(w)));
+    let start = cur.pos;
+    let record = 8 * values;
+    let coord_bytes = cur.take(n * record)?;
+    for (k, rec) in coord_bytes.chunks_exact(record).enumerate() {
+        let x = [cur.decode_f64(rec), cur.decode_f64(&rec[8..]), cur.decode_f64(&rec[16..])];
+        if let Some(i) = x.iter().position(|v| !v.is_finite()) {
+            return Err(cur.malformed(start + k * record + 8 * i, format!("node coordinate {} is not a finite number", x[i])));
+        }
+        coords.push(x);
+    }
+    Ok(())
 }
 
 #[cfg(test)]

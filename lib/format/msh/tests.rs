@@ -725,3 +725,25 @@ fn gmsh_box_prefixes_never_panic() {
         }
     }
 }
+
+/// Timing on a large file: `SC_MSH_BENCH=big.msh cargo test --release --lib msh_bench -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn msh_bench() {
+    let Some(path) = std::env::var_os("SC_MSH_BENCH") else {
+        return;
+    };
+    let bytes = std::fs::read(&path).unwrap();
+    let t = std::time::Instant::now();
+    let (mesh, report) = parse_msh("bench.msh", &bytes).unwrap();
+    println!(
+        "{}: {} nodes, {} hexes, {} face sets, {:?} ({}), warnings {:?}",
+        path.to_string_lossy(),
+        mesh.nodes.len(),
+        mesh.hexes.len(),
+        mesh.face_sets.len(),
+        t.elapsed(),
+        report.version,
+        report.warnings
+    );
+}
