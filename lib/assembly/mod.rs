@@ -8,4 +8,4 @@ pub mod scatter;
 
 pub use dofs::{DofError, DofMap, DOFS_PER_NODE};
 pub use pattern::{NodeGroups, Pattern, PatternError, HEX_DOFS, HEX_ENTRIES, NO_SLOT};
-pub use scatter::{Assembled, Assembly, AssemblyError, ElementFailure, HexMatrix, HexVector};
+pub use scatter::{Assembled, Assembly, AssemblyError, AssemblyTimings, ElementFailure, HexMatrix, HexVector};

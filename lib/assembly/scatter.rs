@@ -14,12 +14,14 @@
 //!    `values` and `residual` are **bit-identical at any thread count** (and equal
 //!    to a sequential assembly in element order).
 //!
-//! Alternatives measured against: element colouring (no buffers, but elements of
-//! one colour race on nothing only if the colouring is exact, needs `unsafe`
-//! writes, and the per-slot order becomes colour-major) — the buffer+gather scheme
-//! needs no `unsafe`, costs ~8 bytes per element-matrix entry, and its gather phase
-//! is a small fraction of the element computation (see the benchmark in
-//! `solver::bench`).
+//! The alternative, element colouring (elements of one colour share no node, so
+//! they can add into `values` directly in parallel), needs no buffers but needs
+//! `unsafe` shared writes, a barrier per colour, and a new colouring whenever the
+//! contact groups change. The buffer + gather scheme needs no `unsafe`; it costs
+//! 8 bytes per element-matrix entry of buffer plus 4 bytes of contribution list,
+//! and [`Assembly::timings`] reports the sum phase separately so its cost can be
+//! compared with the element computation (see `solver::bench`; colouring was not
+//! implemented).
 //!
 //! **No allocation per iteration.** [`Assembly`] owns the element buffers, the
 //! contribution lists and the output arrays; it is built once per [`Pattern`]
@@ -98,6 +100,15 @@ impl<T: Copy + Default> Contributions<T> {
     }
 }
 
+/// Wall times of the last assembly, by phase.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct AssemblyTimings {
+    /// Element routines (parallel over elements).
+    pub compute: std::time::Duration,
+    /// Fixed-order sums into values and residual (parallel over outputs).
+    pub sum: std::time::Duration,
+}
+
 /// Assembly workspace for one [`Pattern`]: element buffers, contribution lists
 /// and the assembled `values` (of `K_ff`, in the pattern's CSC order) and
 /// `residual` (all `3·n_nodes` dofs).
@@ -120,6 +131,7 @@ pub struct Assembly {
     grp_to_dof: Contributions<(u32, u32)>,
     values: Vec<f64>,
     residual: Vec<f64>,
+    timings: AssemblyTimings,
 }
 
 impl Assembly {
@@ -188,6 +200,7 @@ impl Assembly {
             grp_to_dof,
             values: vec![0.0; nnz],
             residual: vec![0.0; n_dofs],
+            timings: AssemblyTimings::default(),
         })
     }
 
@@ -231,6 +244,7 @@ impl Assembly {
             "Assembly workspace used with a different pattern than it was built for"
         );
         // Phase 1: element contributions into private buffers.
+        let start = std::time::Instant::now();
         let hex_failure = self
             .k_hex
             .par_iter_mut()
@@ -261,6 +275,8 @@ impl Assembly {
         }
 
         // Phase 2: fixed-order sums, parallel over outputs.
+        self.timings.compute = start.elapsed();
+        let start = std::time::Instant::now();
         let (k_hex, k_grp) = (&self.k_hex, &self.k_grp);
         let (hex_to_slot, grp_to_slot) = (&self.hex_to_slot, &self.grp_to_slot);
         self.values.par_chunks_mut(GATHER_CHUNK).enumerate().for_each(|(c, chunk)| {
@@ -293,7 +309,13 @@ impl Assembly {
                 *v = sum;
             }
         });
+        self.timings.sum = start.elapsed();
         Ok((&self.values, &self.residual))
+    }
+
+    /// Phase times of the last successful assembly.
+    pub fn timings(&self) -> AssemblyTimings {
+        self.timings
     }
 
     /// Values of `K_ff` from the last assembly, in the pattern's CSC order.
