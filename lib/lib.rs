@@ -21,3 +21,4 @@
 
 pub mod format;
 pub mod mesh;
+pub mod spline;
