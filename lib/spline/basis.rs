@@ -37,6 +37,7 @@ pub fn basis_funs_into(kv: &KnotVector, s: usize, xi: f64, out: &mut [f64; MAX_O
     let p = kv.degree();
     let u = kv.knots();
     let span = p + s;
+    let inv = kv.inv_diff(s);
     let mut left = [0.0; MAX_ORDER];
     let mut right = [0.0; MAX_ORDER];
     out[0] = 1.0;
@@ -45,7 +46,8 @@ pub fn basis_funs_into(kv: &KnotVector, s: usize, xi: f64, out: &mut [f64; MAX_O
         right[j] = u[span + j] - xi;
         let mut saved = 0.0;
         for r in 0..j {
-            let temp = out[r] / (right[r + 1] + left[j - r]);
+            // right[r+1] + left[j−r] is the knot difference ξ_{span+r+1} − ξ_{span+1−j+r}
+            let temp = out[r] * inv[j][r];
             out[r] = saved + right[r + 1] * temp;
             saved = left[j - r] * temp;
         }
@@ -61,8 +63,10 @@ pub fn ders_basis_funs_into(kv: &KnotVector, s: usize, xi: f64, n_ders: usize, d
     let p = kv.degree();
     let u = kv.knots();
     let span = p + s;
-    // ndu[r][j] (r ≤ j): the nonzero basis functions of degree j;
-    // ndu[j][r] (j > r): the knot differences right[r+1] + left[j−r].
+    // ndu[r][j] (r ≤ j): the nonzero basis functions of degree j; the knot
+    // differences right[r+1] + left[j−r] of the lower triangle are precomputed
+    // reciprocals inv[j][r].
+    let inv = kv.inv_diff(s);
     let mut ndu = [[0.0; MAX_ORDER]; MAX_ORDER];
     let mut left = [0.0; MAX_ORDER];
     let mut right = [0.0; MAX_ORDER];
@@ -72,8 +76,7 @@ pub fn ders_basis_funs_into(kv: &KnotVector, s: usize, xi: f64, n_ders: usize, d
         right[j] = u[span + j] - xi;
         let mut saved = 0.0;
         for r in 0..j {
-            ndu[j][r] = right[r + 1] + left[j - r];
-            let temp = ndu[r][j - 1] / ndu[j][r];
+            let temp = ndu[r][j - 1] * inv[j][r];
             ndu[r][j] = saved + right[r + 1] * temp;
             saved = left[j - r] * temp;
         }
@@ -93,18 +96,18 @@ pub fn ders_basis_funs_into(kv: &KnotVector, s: usize, xi: f64, n_ders: usize, d
             let pk = p - k;
             if r >= k {
                 let rk = rk as usize;
-                a[s2][0] = a[s1][0] / ndu[pk + 1][rk];
+                a[s2][0] = a[s1][0] * inv[pk + 1][rk];
                 d = a[s2][0] * ndu[rk][pk];
             }
             let j1 = if rk >= -1 { 1 } else { (-rk) as usize };
             let j2 = if r <= pk + 1 { k - 1 } else { p - r };
             for j in j1..=j2 {
                 let idx = (rk + j as isize) as usize;
-                a[s2][j] = (a[s1][j] - a[s1][j - 1]) / ndu[pk + 1][idx];
+                a[s2][j] = (a[s1][j] - a[s1][j - 1]) * inv[pk + 1][idx];
                 d += a[s2][j] * ndu[idx][pk];
             }
             if r <= pk {
-                a[s2][k] = -a[s1][k - 1] / ndu[pk + 1][r];
+                a[s2][k] = -a[s1][k - 1] * inv[pk + 1][r];
                 d += a[s2][k] * ndu[r][pk];
             }
             ders[k][r] = d;

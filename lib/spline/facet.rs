@@ -287,7 +287,7 @@ mod tests {
         let facets = FacetSurface::new(9, 5).unwrap();
         let proj = FacetProjector::new(facets.clone(), &x).unwrap();
         // brute force over the facet set
-        let m = 400;
+        let m = 250;
         let dense: Vec<Vec3> = (0..=m)
             .flat_map(|i| (0..=m).map(move |j| [i as f64 / m as f64, j as f64 / m as f64]))
             .map(|xi| facets.point(&x, xi))

@@ -24,6 +24,11 @@ pub struct KnotVector {
     n: usize,
     order: usize,
     knots: Vec<f64>,
+    /// Per span s, `inv_diff[s][j][r] = 1 / (ξ_{p+s+r+1} − ξ_{p+s+1−j+r})` for
+    /// `0 ≤ r < j ≤ p`: the reciprocal knot differences of the triangular basis scheme
+    /// (independent of ξ, never zero on a nonempty span), so evaluation needs no
+    /// division.
+    inv_diff: Vec<[[f64; MAX_ORDER]; MAX_ORDER]>,
 }
 
 impl KnotVector {
@@ -45,7 +50,20 @@ impl KnotVector {
         knots.extend((1..m).map(|s| s as f64 / m as f64));
         knots.extend(std::iter::repeat_n(1.0, order));
         debug_assert_eq!(knots.len(), n + order);
-        Ok(Self { n, order, knots })
+        let p = order - 1;
+        let inv_diff = (0..m)
+            .map(|s| {
+                let span = p + s;
+                let mut t = [[0.0; MAX_ORDER]; MAX_ORDER];
+                for (j, row) in t.iter_mut().enumerate().take(p + 1).skip(1) {
+                    for (r, v) in row.iter_mut().enumerate().take(j) {
+                        *v = 1.0 / (knots[span + r + 1] - knots[span + 1 + r - j]);
+                    }
+                }
+                t
+            })
+            .collect();
+        Ok(Self { n, order, knots, inv_diff })
     }
 
     /// Number of control points (basis functions) `n`.
@@ -100,6 +118,11 @@ impl KnotVector {
             s += 1;
         }
         s
+    }
+
+    /// Reciprocal knot differences of span `s` (see the field docs).
+    pub(crate) fn inv_diff(&self, s: usize) -> &[[f64; MAX_ORDER]; MAX_ORDER] {
+        &self.inv_diff[s]
     }
 
     /// Index of the first basis function that is nonzero on span `s`; the nonzero
