@@ -11,9 +11,10 @@
 //! ```
 //! Algorithm:
 //! 1. **Global search** ([`SpanTree`]): branch and bound over the span boxes (each
-//!    holds its span by the convex-hull property); every candidate span is sampled
-//!    on an m×m grid and the best sample tightens the bound, so every span whose box
-//!    is farther than the best sample is skipped.
+//!    holds its span by the convex-hull property, here of the span's Bézier points);
+//!    the distance to each candidate span's 3×3 precomputed samples (refitted with the
+//!    tree) tightens the bound, so every span whose box is farther than the best
+//!    sample is skipped.
 //! 2. **Newton** from the best sample on the whole domain: step `H Δξ = −r` (the
 //!    Gauss–Newton matrix ā_αβ replaces H where H is not positive definite, i.e.
 //!    beyond a centre of curvature), the step length clamped to one knot span per
@@ -287,7 +288,7 @@ impl BSplineProjector {
     /// Builds the span tree for `patch` and fits it to the control points `x`.
     pub fn new(patch: BSplinePatch, x: &[Vec3]) -> Result<Self, SplineError> {
         patch.check_control_net(x)?;
-        let tree = SpanTree::new(patch.n_spans(), patch.orders());
+        let tree = SpanTree::with_extraction([patch.knots(0), patch.knots(1)]);
         let samples = SpanSamples::new(&patch);
         let mut s = Self { patch, x: Vec::new(), tree, samples, scale: 0.0, options: ProjectionOptions::default() };
         s.update(x)?;

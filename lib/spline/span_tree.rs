@@ -16,7 +16,8 @@
 //! current distance bound of a point; the visitor tightens the bound as it finds
 //! surface points (branch and bound).
 
-use super::Vec3;
+use super::{KnotVector, Vec3, MAX_ORDER};
+use super::basis::basis_funs_into;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Node {
@@ -56,7 +57,13 @@ pub struct SpanTree {
     window: [usize; 2],
     na: usize,
     nodes: Vec<Node>,
+    /// Optional Bézier extraction per direction: `[dir][span][r][i]`, the Bézier
+    /// point i of a span is `Σ_r E[r][i] B_r` (see [`Self::with_extraction`]).
+    extraction: Option<[Vec<Extraction>; 2]>,
 }
+
+/// k×k Bézier extraction matrix of one span in one direction (`[r][i]`).
+pub type Extraction = [[f64; MAX_ORDER]; MAX_ORDER];
 
 /// Deepest hierarchy a query can walk (2⁶⁰ spans — never reached).
 const STACK: usize = 128;
@@ -68,8 +75,21 @@ impl SpanTree {
     pub fn new(n_spans: [usize; 2], window: [usize; 2]) -> Self {
         assert!(n_spans[0] > 0 && n_spans[1] > 0, "at least one span per direction");
         let na = n_spans[0] + window[0] - 1;
-        let mut tree = Self { n_spans, window, na, nodes: Vec::with_capacity(2 * n_spans[0] * n_spans[1]) };
+        let mut tree =
+            Self { n_spans, window, na, nodes: Vec::with_capacity(2 * n_spans[0] * n_spans[1]), extraction: None };
         tree.build(0, n_spans[0] as u32, 0, n_spans[1] as u32);
+        tree
+    }
+
+    /// Like [`Self::new`] for a B-spline patch, with tighter leaf boxes: each span's
+    /// piece is a Bézier patch whose control points (Bézier extraction,
+    /// `N_r = Σ_i E_ri B_i` with B_i the Bernstein polynomials of the span) lie in the
+    /// convex hull of the span's B-spline control points and still enclose the
+    /// piece — the box of the Bézier points is never larger and usually about half
+    /// as wide per direction.
+    pub fn with_extraction(knots: [&KnotVector; 2]) -> Self {
+        let mut tree = Self::new([knots[0].n_spans(), knots[1].n_spans()], [knots[0].order(), knots[1].order()]);
+        tree.extraction = Some(knots.map(|kv| (0..kv.n_spans()).map(|s| extraction(kv, s)).collect()));
         tree
     }
 
@@ -97,6 +117,7 @@ impl SpanTree {
 
     /// Recomputes every box from the current control points `x` (`i + na·j`).
     /// Children are stored after their parent, so one reverse sweep suffices.
+    #[allow(clippy::needless_range_loop)] // i, j, r, c: the indices of the extraction sums
     pub fn refit(&mut self, x: &[Vec3]) {
         let [ka, kb] = self.window;
         let na = self.na;
@@ -104,7 +125,38 @@ impl SpanTree {
         for id in (0..self.nodes.len()).rev() {
             let node = self.nodes[id];
             let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-            if node.is_leaf() {
+            if let (true, Some([ea, eb])) = (node.is_leaf(), &self.extraction) {
+                let (s, t) = (node.s0 as usize, node.t0 as usize);
+                let (ea, eb) = (&ea[s], &eb[t]);
+                // rows[i][c] = Σ_r E^a_ri B_{s+r, t+c}; Bézier point (i, j) = Σ_c E^b_cj rows[i][c]
+                let mut rows = [[Vec3::zeros(); MAX_ORDER]; MAX_ORDER];
+                for (i, row) in rows.iter_mut().enumerate().take(ka) {
+                    for (c, v) in row.iter_mut().enumerate().take(kb) {
+                        let base = s + na * (t + c);
+                        for (r, b) in x[base..base + ka].iter().enumerate() {
+                            *v += b * ea[r][i];
+                        }
+                    }
+                }
+                for row in rows.iter().take(ka) {
+                    for j in 0..kb {
+                        let mut q = Vec3::zeros();
+                        for (c, v) in row.iter().enumerate().take(kb) {
+                            q += v * eb[c][j];
+                        }
+                        for c in 0..3 {
+                            lo[c] = lo[c].min(q[c]);
+                            hi[c] = hi[c].max(q[c]);
+                        }
+                    }
+                }
+                // pad for the round-off of the extraction
+                let pad = 1e-12 * (0..3).map(|c| hi[c] - lo[c]).fold(0.0, f64::max);
+                for c in 0..3 {
+                    lo[c] -= pad;
+                    hi[c] += pad;
+                }
+            } else if node.is_leaf() {
                 let (s, t) = (node.s0 as usize, node.t0 as usize);
                 for j in t..t + kb {
                     for p in &x[s + na * j..s + na * j + ka] {
@@ -187,6 +239,34 @@ impl SpanTree {
     }
 }
 
+/// Bézier extraction of span `s`: solves `N(u_q) = Bern(u_q) Eᵀ` at k points.
+fn extraction(kv: &KnotVector, s: usize) -> Extraction {
+    let k = kv.order();
+    let p = k - 1;
+    let (lo, hi) = kv.span_bounds(s);
+    let mut m_b = nalgebra::DMatrix::<f64>::zeros(k, k);
+    let mut m_n = nalgebra::DMatrix::<f64>::zeros(k, k);
+    for q in 0..k {
+        let tau = (q as f64 + 0.5) / k as f64;
+        let mut vals = [0.0; MAX_ORDER];
+        basis_funs_into(kv, s, lo + (hi - lo) * tau, &mut vals);
+        let mut binom = 1.0;
+        for i in 0..k {
+            m_b[(q, i)] = binom * tau.powi(i as i32) * (1.0 - tau).powi((p - i) as i32);
+            binom = binom * (p - i) as f64 / (i + 1) as f64;
+            m_n[(q, i)] = vals[i];
+        }
+    }
+    let e_t = m_b.lu().solve(&m_n).expect("Bernstein collocation matrix is regular");
+    let mut e = [[0.0; MAX_ORDER]; MAX_ORDER];
+    for r in 0..k {
+        for i in 0..k {
+            e[r][i] = e_t[(i, r)];
+        }
+    }
+    e
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -238,5 +318,38 @@ mod tests {
         tree.refit(&moved);
         let (lo, _) = tree.span_box([0, 0]);
         assert!(lo.z > 8.0);
+    }
+
+    #[test]
+    fn bezier_boxes_are_tighter_and_still_hold_the_surface() {
+        use super::super::BSplinePatch;
+        for (ka, kb) in [(3, 3), (4, 2), (5, 4)] {
+            let (na, nb) = (10, 9);
+            let x = net(na, nb);
+            let patch = BSplinePatch::new(na, nb, ka, kb).unwrap();
+            let mut loose = SpanTree::new(patch.n_spans(), [ka, kb]);
+            let mut tight = SpanTree::with_extraction([patch.knots(0), patch.knots(1)]);
+            loose.refit(&x);
+            tight.refit(&x);
+            let (mut vol_l, mut vol_t) = (0.0, 0.0);
+            for s in 0..patch.n_spans()[0] {
+                for t in 0..patch.n_spans()[1] {
+                    let (ll, lh) = loose.span_box([s, t]);
+                    let (tl, th) = tight.span_box([s, t]);
+                    assert!((0..3).all(|c| tl[c] >= ll[c] - 1e-10 && th[c] <= lh[c] + 1e-10), "inside the hull box (up to the pad)");
+                    vol_l += (lh - ll).iter().product::<f64>();
+                    vol_t += (th - tl).iter().product::<f64>();
+                    let ((a0, a1), (b0, b1)) = (patch.knots(0).span_bounds(s), patch.knots(1).span_bounds(t));
+                    for i in 0..=8 {
+                        for j in 0..=8 {
+                            let xi = [a0 + (a1 - a0) * i as f64 / 8.0, b0 + (b1 - b0) * j as f64 / 8.0];
+                            let q = patch.point(&x, xi);
+                            assert!((0..3).all(|c| tl[c] <= q[c] && q[c] <= th[c]), "ka={ka} kb={kb} span ({s},{t}) {xi:?}");
+                        }
+                    }
+                }
+            }
+            assert!(vol_t < 0.5 * vol_l, "ka={ka} kb={kb}: {vol_t} vs {vol_l}");
+        }
     }
 }
