@@ -29,4 +29,5 @@ pub mod mesh;
 pub mod pipeline;
 pub mod post;
 pub mod solver;
+pub mod spline;
 pub mod stages;
