@@ -33,7 +33,8 @@ fn main() -> ExitCode {
             eprintln!("{line}");
         }
     };
-    match splinecontact::pipeline::run(&args.pipeline, &mut log) {
+    let verbosity = if quiet { splinecontact::solver::log::Verbosity::Quiet } else { splinecontact::solver::log::Verbosity::Normal };
+    match splinecontact::pipeline::run(&args.pipeline, verbosity, &mut log) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("sc-pipeline: error: {e}");

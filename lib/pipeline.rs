@@ -4,6 +4,8 @@
 use std::path::{Path, PathBuf};
 
 use crate::format::pipeline::{resolve, Pipeline, PipelineError, Stage};
+use crate::format::setup::SolveSetup;
+use crate::solver::log::Verbosity;
 use crate::stages::{self, StageRunError};
 
 /// A failed pipeline: which stage, and why.
@@ -34,7 +36,7 @@ fn ensure_parent(p: &Path) -> Result<(), StageRunError> {
 }
 
 /// Run every stage of the pipeline at `path`; `log` receives one line per event.
-pub fn run(path: &Path, log: &mut dyn FnMut(&str)) -> Result<(), RunError> {
+pub fn run(path: &Path, verbosity: Verbosity, log: &mut dyn FnMut(&str)) -> Result<(), RunError> {
     let pipeline = Pipeline::read(path)?;
     let base: PathBuf = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let n = pipeline.stages.len();
@@ -59,6 +61,27 @@ pub fn run(path: &Path, log: &mut dyn FnMut(&str)) -> Result<(), RunError> {
                 for line in stages::import::summary(&input, &mesh, &report) {
                     log(&format!("      {line}"));
                 }
+            }
+            Stage::Solve(s) => {
+                let (input, out) = (resolve(&base, &s.input), resolve(&base, &s.output));
+                log(&format!("[{index}/{n}] solve {} -> {}", input.display(), out.display()));
+                ensure_parent(&out).map_err(fail)?;
+                let (setup, setup_name) = match (&s.setup, &s.setup_file) {
+                    (Some(setup), None) => (setup.clone(), format!("{} (solve stage {index})", path.display())),
+                    (None, Some(f)) => {
+                        let f = resolve(&base, f);
+                        (SolveSetup::read(&f).map_err(|e| fail(e.into()))?, f.display().to_string())
+                    }
+                    _ => {
+                        return Err(fail(StageRunError::Usage(format!(
+                            "{}: solve stage {index}: give exactly one of `setup` (inline) or `setup_file`",
+                            path.display()
+                        ))))
+                    }
+                };
+                let csv = s.csv.as_ref().map(|c| resolve(&base, c)).or_else(|| stages::solve::default_csv_path(&out));
+                let r = stages::solve::solve(&input, &setup, &setup_name, &out, csv.as_deref(), verbosity).map_err(fail)?;
+                log(&format!("      {} increments, {} Newton iterations, {} cutbacks, {:.2} s", r.increments, r.iterations, r.cutbacks, r.seconds));
             }
             Stage::Export(s) => {
                 let (input, out) = (resolve(&base, &s.input), resolve(&base, &s.output));

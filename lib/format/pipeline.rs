@@ -15,6 +15,7 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 
 use crate::stages::export::ExportFormat;
+use crate::format::setup::SolveSetup;
 use crate::stages::gmsh::MshFlavour;
 
 /// The pipeline versions this build reads.
@@ -39,6 +40,7 @@ pub struct Pipeline {
 pub enum Stage {
     Gmsh(GmshStage),
     Import(ImportStage),
+    Solve(SolveStage),
     Export(ExportStage),
 }
 
@@ -47,6 +49,7 @@ impl Stage {
         match self {
             Self::Gmsh(_) => "gmsh",
             Self::Import(_) => "import",
+            Self::Solve(_) => "solve",
             Self::Export(_) => "export",
         }
     }
@@ -70,6 +73,21 @@ pub struct GmshStage {
 pub struct ImportStage {
     pub input: PathBuf,
     pub output: PathBuf,
+}
+
+/// Solve: the setup inline (`setup:`) or in a file (`setup_file:`).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SolveStage {
+    pub input: PathBuf,
+    pub output: PathBuf,
+    #[serde(default)]
+    pub setup: Option<SolveSetup>,
+    #[serde(default)]
+    pub setup_file: Option<PathBuf>,
+    /// Convergence history CSV (default: beside the output).
+    #[serde(default)]
+    pub csv: Option<PathBuf>,
 }
 
 #[derive(Debug, Deserialize)]

@@ -15,10 +15,10 @@
 //! newton: {max_iterations: 25, residual_tolerance: 1.0e-8}
 //! ```
 
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 /// Material models.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ModelName {
     /// Compressible neo-Hookean, Ciarlet–Simo form (paper eq. 3.3 / 8.1).
@@ -29,7 +29,7 @@ pub enum ModelName {
     LinearElastic,
 }
 
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct MaterialSetup {
     /// Body name (a gmsh physical volume).
@@ -43,14 +43,14 @@ pub struct MaterialSetup {
     pub mu: Option<f64>,
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Formulation {
     TotalLagrangian,
     UpdatedLagrangian,
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Component {
     X,
@@ -69,7 +69,7 @@ impl Component {
 }
 
 /// Prescribed displacement components, ramped with the load factor.
-#[derive(Debug, Clone, Default, Deserialize)]
+#[derive(Debug, Clone, Default, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct Components {
     pub x: Option<f64>,
@@ -85,7 +85,7 @@ impl Components {
 
 /// A Dirichlet condition on a node set: `fix` components to zero and/or prescribe
 /// `displacement` components (scaled by the load factor).
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct ConstraintSetup {
     pub set: String,
@@ -97,7 +97,7 @@ pub struct ConstraintSetup {
 
 /// A load: a force on a node set (total, spread evenly over its nodes, or
 /// `per_node`), or a follower pressure on a face set. Scaled by the load factor.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct LoadSetup {
     pub set: Option<String>,
@@ -110,7 +110,7 @@ pub struct LoadSetup {
 }
 
 /// Load factors: `count` equal increments up to 1, or an explicit increasing list.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct IncrementSetup {
     pub count: Option<u32>,
@@ -130,7 +130,7 @@ impl Default for IncrementSetup {
     }
 }
 
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct NewtonSetup {
     #[serde(default = "default_max_iterations")]
@@ -159,7 +159,7 @@ impl Default for NewtonSetup {
     }
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, Default)]
 #[serde(rename_all = "lowercase")]
 pub enum LinearSolverChoice {
     /// Cholesky while the tangent is symmetric (LDLᵀ if it is indefinite), LU otherwise.
@@ -171,7 +171,7 @@ pub enum LinearSolverChoice {
 }
 
 /// The whole setup.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct SolveSetup {
     #[serde(default = "default_formulation")]

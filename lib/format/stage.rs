@@ -401,6 +401,17 @@ impl StageFile {
         Self::parse(&shown, &bytes, expected)
     }
 
+    /// Read any stage file; when its format is one of `known` (name, major version
+    /// read), the version is checked as [`StageFile::read`] would, before anything else.
+    pub fn read_known(path: &Path, known: &[(&str, u32)]) -> Result<Self, StageError> {
+        let shown = path.display().to_string();
+        let bytes = read_input(path).map_err(|source| StageError::Io { path: shown.clone(), action: "read", source })?;
+        let head = &bytes[..bytes.len().min(256)];
+        let format = head.split(|&b| b == b'\n').next().and_then(|l| std::str::from_utf8(l).ok()).and_then(|l| l.split(' ').nth(1));
+        let expected = format.and_then(|f| known.iter().find(|(k, _)| *k == f)).copied();
+        Self::parse(&shown, &bytes, expected)
+    }
+
     pub fn array(&self, name: &str) -> Option<&Array> {
         self.arrays.iter().find(|a| a.name == name)
     }

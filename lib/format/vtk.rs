@@ -168,7 +168,7 @@ impl Grid {
             data: Attributes { point: attr(self.point_data), cell: attr(self.cell_data) },
         };
         let vtk = Vtk {
-            version: Version::new_xml(2, 2),
+            version: Version::new_xml(1, 0),
             title: String::new(),
             byte_order: ByteOrder::LittleEndian,
             data: DataSet::inline(piece),

@@ -1,8 +1,14 @@
-//! Solvers: the linear-solver interface and its faer direct backend
-//! ([`linear`]), and a timing benchmark on a clamped elastic cube ([`bench`]).
+//! Solvers: the linear-solver interface and its faer direct backend ([`linear`]),
+//! the static problem ([`problem`]), Newton–Raphson for one increment ([`newton`]),
+//! load stepping with cutbacks ([`increments`]), what the user sees ([`log`]), and a
+//! timing benchmark on a clamped elastic cube ([`bench`]).
 
 pub mod bench;
+pub mod increments;
 pub mod linear;
+pub mod log;
+pub mod newton;
+pub mod problem;
 
 pub use linear::{
     FactorInfo, FaerDirect, FaerDirectOptions, Factorization, LinearSolver, LinearSolverError, SolverTimings, SymmetricStrategy, Symmetry,

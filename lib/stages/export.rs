@@ -44,7 +44,7 @@ pub fn export(input: &Path, output: &Path, format: Option<ExportFormat>) -> Resu
             )))
         }
     };
-    let file = StageFile::read(input, None)?;
+    let file = StageFile::read_known(input, &[(scmesh::FORMAT, scmesh::MAJOR), (scres::FORMAT, scres::MAJOR)])?;
     match format {
         ExportFormat::Yaml => {
             write_atomic_with(output, |w| file.dump_yaml(w))?;
@@ -52,10 +52,6 @@ pub fn export(input: &Path, output: &Path, format: Option<ExportFormat>) -> Resu
         }
         ExportFormat::Vtu => match file.format.as_str() {
             scmesh::FORMAT => {
-                if file.major != scmesh::MAJOR {
-                    // Re-read through the checked path for the proper version message.
-                    StageFile::read(input, Some((scmesh::FORMAT, scmesh::MAJOR)))?;
-                }
                 let mesh = scmesh::from_stage(&file)?;
                 let (n, m) = (mesh.nodes.len(), mesh.hexes.len());
                 vtk::mesh_grid(&mesh).write_vtu(output)?;
@@ -65,9 +61,6 @@ pub fn export(input: &Path, output: &Path, format: Option<ExportFormat>) -> Resu
         },
         ExportFormat::Pvd => match file.format.as_str() {
             scres::FORMAT => {
-                if file.major != scres::MAJOR {
-                    StageFile::read(input, Some((scres::FORMAT, scres::MAJOR)))?;
-                }
                 let results = Results::from_stage(&file)?;
                 write_results_pvd(&results, output)
             }

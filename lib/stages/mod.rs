@@ -5,8 +5,13 @@
 pub mod export;
 pub mod gmsh;
 pub mod import;
+pub mod solve;
 
 use crate::format::msh::MshError;
+use crate::format::setup::SetupError;
+use crate::solver::increments::SolveError;
+use crate::solver::newton::SetupFailure;
+use crate::solver::problem::ProblemError;
 use crate::format::stage::StageError;
 use crate::format::vtk::VtkError;
 
@@ -29,6 +34,14 @@ pub enum StageRunError {
     Stage(#[from] StageError),
     #[error(transparent)]
     Vtk(#[from] VtkError),
+    #[error(transparent)]
+    Setup(#[from] SetupError),
+    #[error(transparent)]
+    Problem(#[from] ProblemError),
+    #[error(transparent)]
+    SolverSetup(#[from] SetupFailure),
+    #[error(transparent)]
+    Solve(#[from] SolveError),
     #[error("{0}")]
     Usage(String),
     #[error("{0}")]
@@ -39,7 +52,12 @@ impl StageRunError {
     /// The process exit code this error maps to.
     pub fn exit_code(&self) -> u8 {
         match self {
-            Self::Stage(StageError::Io { .. }) | Self::Vtk(VtkError::Stage(StageError::Io { .. })) | Self::Tool(_) => exit_code::IO,
+            Self::Stage(StageError::Io { .. })
+            | Self::Msh(MshError::Io { .. })
+            | Self::Vtk(VtkError::Stage(StageError::Io { .. }))
+            | Self::Solve(SolveError::Write(StageError::Io { .. }))
+            | Self::Tool(_) => exit_code::IO,
+            Self::Solve(SolveError::Diverged { .. }) => exit_code::DIVERGED,
             _ => exit_code::BAD_INPUT,
         }
     }

@@ -1,6 +1,8 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code)]
 
+pub mod grid;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -64,8 +66,10 @@ pub fn gmsh() -> PathBuf {
 
 /// Mesh `geo` with gmsh into `out` with extra CLI flags (e.g. `-format msh22`).
 pub fn gmsh_mesh(geo: &Path, out: &Path, flags: &[&str]) {
-    let o = Command::new(gmsh()).arg(geo).arg("-3").args(flags).arg("-o").arg(out).output().expect("gmsh runs");
-    assert!(o.status.success() && out.is_file(), "gmsh failed: {}", String::from_utf8_lossy(&o.stdout));
+    // The PyPI gmsh script starts with `#!/usr/bin/env python`: the venv must come first on PATH.
+    let path = format!("{}:{}", python().parent().expect("venv bin").display(), std::env::var("PATH").unwrap_or_default());
+    let o = Command::new(gmsh()).arg(geo).arg("-3").args(flags).arg("-o").arg(out).env("PATH", path).output().expect("gmsh runs");
+    assert!(o.status.success() && out.is_file(), "gmsh failed: {}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
 }
 
 pub fn python_script(script: &str, args: &[&Path]) -> Output {

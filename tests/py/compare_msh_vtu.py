@@ -18,7 +18,13 @@ import numpy as np
 
 def hexes(mesh):
     blocks = [c.data for c in mesh.cells if c.type == "hexahedron"]
-    return np.concatenate(blocks) if blocks else np.zeros((0, 8), dtype=int)
+    h = np.concatenate(blocks) if blocks else np.zeros((0, 8), dtype=np.int64)
+    # meshio 5.3 on NumPy 2 adds an int64 offset to our UInt64 connectivity, which
+    # NumPy promotes to float64: convert back, checking the values are exact integers.
+    if h.dtype.kind == "f":
+        assert np.array_equal(h, np.round(h)), "non-integer connectivity"
+        h = h.astype(np.int64)
+    return h
 
 
 def main():

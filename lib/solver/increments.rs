@@ -1,0 +1,176 @@
+//! Load stepping: the load factors of the setup, one Newton solve each; a failed
+//! increment (no convergence, divergence, an inverted element) is cut back — the step
+//! halved — up to `max_cutbacks` times in a row, then the solve stops. Every
+//! converged increment is written to the results file as soon as it converges, so a
+//! stopped run keeps all of them on disk.
+
+use std::path::Path;
+use std::time::Instant;
+
+use super::log::{IterationEvent, SolveLog};
+use super::newton::{gauss_stresses, IncrementFailure, Newton};
+use super::problem::Problem;
+use crate::assembly::DOFS_PER_NODE;
+use crate::format::scres::{Increment, IncrementInfo, Reaction, Results, RunStatus};
+use crate::format::stage::{write_atomic, StageError};
+
+/// The solve stopped.
+#[derive(Debug, thiserror::Error)]
+pub enum SolveError {
+    #[error("solve stopped at increment {increment} (load factor {load_factor:.6}, last converged {last_converged:.6}) after {cutbacks} cutbacks: {failure}{worst}; the {kept} converged increments are in {results}")]
+    Diverged {
+        increment: usize,
+        load_factor: f64,
+        last_converged: f64,
+        cutbacks: u32,
+        failure: IncrementFailure,
+        worst: String,
+        kept: usize,
+        results: String,
+    },
+    #[error(transparent)]
+    Write(#[from] StageError),
+}
+
+/// What a finished solve reports.
+pub struct SolveSummary {
+    pub increments: usize,
+    pub iterations: usize,
+    pub cutbacks: u32,
+}
+
+/// Where the results go.
+pub struct Outputs<'a> {
+    pub results: &'a Path,
+    pub csv: Option<&'a Path>,
+}
+
+fn worst_element(results: &Results, failure: &IncrementFailure) -> String {
+    match failure {
+        IncrementFailure::Element { element, .. } => {
+            let tag = results.mesh.element_tags.get(*element).copied().unwrap_or_default();
+            format!(" (worst element: hexahedron {element}, gmsh tag {tag})")
+        }
+        _ => String::new(),
+    }
+}
+
+/// Run all increments; `results` holds the mesh and setup and receives the increments.
+pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &mut Results, out: &Outputs, log: &mut SolveLog) -> Result<SolveSummary, SolveError> {
+    let p: &Problem = newton.problem;
+    let mut u = vec![0.0; DOFS_PER_NODE * p.n_nodes()];
+    let mut trial = u.clone();
+    let mut lambda_prev = 0.0;
+    let mut summary = SolveSummary { increments: 0, iterations: 0, cutbacks: 0 };
+    let write = |results: &Results, log: &SolveLog| -> Result<(), StageError> {
+        results.write(out.results)?;
+        if let Some(csv) = out.csv {
+            write_atomic(csv, log.csv().as_bytes())?;
+        }
+        Ok(())
+    };
+    let n_inc = factors.len();
+    for (k, &target) in factors.iter().enumerate() {
+        let mut lambda = target;
+        let mut failures = 0u32;
+        let mut cutbacks_this = 0u32;
+        loop {
+            trial.copy_from_slice(&u);
+            let attempt = cutbacks_this;
+            let outcome = {
+                let mut on_it = |row: &crate::format::scres::IterationLog| {
+                    log.iteration(&IterationEvent {
+                        increment: k + 1,
+                        n_increments: n_inc,
+                        load_factor: lambda,
+                        attempt,
+                        iteration: row.iteration,
+                        residual: row.residual,
+                        energy: row.energy,
+                        seconds_assembly: row.seconds_assembly,
+                        seconds_factor: row.seconds_factor,
+                        seconds_solve: row.seconds_solve,
+                    })
+                };
+                newton.solve_increment(lambda, &mut trial, &mut on_it)
+            };
+            match outcome {
+                Ok(conv) => {
+                    let t = Instant::now();
+                    u.copy_from_slice(&trial);
+                    let stress = match gauss_stresses(p, &u) {
+                        Ok(s) => s,
+                        Err((element, error)) => {
+                            let failure = IncrementFailure::Element { iteration: 0, element, error };
+                            return Err(stop(results, out, log, k + 1, lambda, lambda_prev, cutbacks_this, failure));
+                        }
+                    };
+                    summary.iterations += conv.iterations.len().saturating_sub(1);
+                    let reactions = newton.reactions().into_iter().map(|(set, force)| Reaction { set, force }).collect();
+                    results.increments.push(Increment {
+                        info: IncrementInfo { load_factor: lambda, cutbacks: cutbacks_this, iterations: conv.iterations, reactions, seconds_output: 0.0 },
+                        u: u.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
+                        stress,
+                    });
+                    write(results, log)?;
+                    if let Some(last) = results.increments.last_mut() {
+                        last.info.seconds_output = t.elapsed().as_secs_f64();
+                    }
+                    summary.increments += 1;
+                    log.line(&format!(
+                        "increment {}/{n_inc} converged at load factor {lambda:.6} in {} iterations{}",
+                        k + 1,
+                        results.increments.last().map(|i| i.info.iterations.len().saturating_sub(1)).unwrap_or(0),
+                        if cutbacks_this > 0 { format!(" ({cutbacks_this} cutbacks)") } else { String::new() }
+                    ));
+                    lambda_prev = lambda;
+                    failures = 0;
+                    if lambda >= target {
+                        break;
+                    }
+                    lambda = target;
+                }
+                Err(failure) => {
+                    failures += 1;
+                    if failures > max_cutbacks {
+                        return Err(stop(results, out, log, k + 1, lambda, lambda_prev, cutbacks_this, failure));
+                    }
+                    cutbacks_this += 1;
+                    summary.cutbacks += 1;
+                    let next = lambda_prev + 0.5 * (lambda - lambda_prev);
+                    log.line(&format!("increment {}/{n_inc} at load factor {lambda:.6}: {failure}; cutting back to {next:.6}", k + 1));
+                    lambda = next;
+                }
+            }
+        }
+        log.increment_done();
+    }
+    results.status = RunStatus::Completed;
+    write(results, log)?;
+    Ok(summary)
+}
+
+#[allow(clippy::too_many_arguments)]
+fn stop(results: &mut Results, out: &Outputs, log: &SolveLog, increment: usize, load_factor: f64, last_converged: f64, cutbacks: u32, failure: IncrementFailure) -> SolveError {
+    let worst = worst_element(results, &failure);
+    let reason = format!("increment {increment} at load factor {load_factor:.6}: {failure}{worst}");
+    results.status = RunStatus::Stopped { reason };
+    if let Err(e) = results.write(out.results) {
+        return SolveError::Write(e);
+    }
+    if let Some(csv) = out.csv {
+        if let Err(e) = write_atomic(csv, log.csv().as_bytes()) {
+            return SolveError::Write(e);
+        }
+    }
+    SolveError::Diverged {
+        increment,
+        load_factor,
+        last_converged,
+        cutbacks,
+        failure,
+        worst,
+        kept: results.increments.len(),
+        results: out.results.display().to_string(),
+    }
+}

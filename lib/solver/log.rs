@@ -1,0 +1,100 @@
+//! What the user sees during a solve: one line per Newton iteration (increment,
+//! iteration, residual, energy) — as a progress bar on a terminal, as plain log
+//! lines otherwise — and the convergence history as a CSV to plot.
+
+use std::io::{IsTerminal, Write};
+
+use indicatif::{ProgressBar, ProgressStyle};
+
+/// How much to print.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Verbosity {
+    Quiet,
+    Normal,
+}
+
+/// One Newton iteration as reported.
+#[derive(Debug, Clone, Copy)]
+pub struct IterationEvent {
+    pub increment: usize,
+    pub n_increments: usize,
+    pub load_factor: f64,
+    pub attempt: u32,
+    pub iteration: u32,
+    pub residual: f64,
+    pub energy: f64,
+    pub seconds_assembly: f64,
+    pub seconds_factor: f64,
+    pub seconds_solve: f64,
+}
+
+/// Progress reporting plus the CSV history.
+pub struct SolveLog {
+    verbosity: Verbosity,
+    bar: Option<ProgressBar>,
+    csv: String,
+}
+
+impl SolveLog {
+    pub const CSV_HEADER: &'static str = "increment,load_factor,attempt,iteration,residual,energy,seconds_assembly,seconds_factor,seconds_solve\n";
+
+    pub fn new(verbosity: Verbosity, n_increments: usize) -> Self {
+        let bar = (verbosity == Verbosity::Normal && std::io::stderr().is_terminal()).then(|| {
+            let b = ProgressBar::new(n_increments as u64);
+            b.set_style(ProgressStyle::with_template("{elapsed_precise} [{bar:30}] increment {pos}/{len} {msg}").expect("valid template").progress_chars("=> "));
+            b
+        });
+        Self { verbosity, bar, csv: Self::CSV_HEADER.to_string() }
+    }
+
+    /// A message line (shown above the bar on a terminal).
+    pub fn line(&self, text: &str) {
+        if self.verbosity == Verbosity::Quiet {
+            return;
+        }
+        match &self.bar {
+            Some(b) => b.println(text),
+            None => {
+                let _ = writeln!(std::io::stderr(), "{text}");
+            }
+        }
+    }
+
+    pub fn iteration(&mut self, e: &IterationEvent) {
+        self.csv.push_str(&format!(
+            "{},{:e},{},{},{:e},{:e},{:.6},{:.6},{:.6}\n",
+            e.increment, e.load_factor, e.attempt, e.iteration, e.residual, e.energy, e.seconds_assembly, e.seconds_factor, e.seconds_solve
+        ));
+        let text = format!(
+            "increment {}/{} (λ = {:.4}{}) iteration {:>2}: residual {:.3e}, energy {:.3e}",
+            e.increment,
+            e.n_increments,
+            e.load_factor,
+            if e.attempt > 0 { format!(", cutback {}", e.attempt) } else { String::new() },
+            e.iteration,
+            e.residual,
+            e.energy
+        );
+        match &self.bar {
+            Some(b) => b.set_message(text),
+            None => self.line(&text),
+        }
+    }
+
+    pub fn increment_done(&self) {
+        if let Some(b) = &self.bar {
+            b.inc(1);
+        }
+    }
+
+    pub fn finish(&self) {
+        if let Some(b) = &self.bar {
+            b.finish_and_clear();
+        }
+    }
+
+    /// The convergence history so far, as CSV text.
+    pub fn csv(&self) -> &str {
+        &self.csv
+    }
+}

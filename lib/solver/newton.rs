@@ -1,0 +1,230 @@
+//! Newton–Raphson for one load increment (style: deal.II step-44): assemble the
+#![allow(non_snake_case)] // paper notation: X (reference coordinates)
+//! residual R(u) = f_int(u) − f_ext(λ) and the tangent K_ff, solve K_ff Δu = −R_f,
+//! update, until the residual (relative to the external or reaction force) and the
+//! energy norm of the correction are both below tolerance.
+
+use std::time::Instant;
+
+use nalgebra::{DMatrix, DVector, Vector3};
+
+use super::problem::Problem;
+use crate::assembly::{Assembly, AssemblyError, ElementFailure, NodeGroups, Pattern, PatternError, DOFS_PER_NODE};
+use crate::fem::element::{hex8_gauss_stresses, hex8_residual_tangent, ElementError};
+use crate::fem::pressure::{follower_pressure_force_stiffness, FaceMatrix, FaceVector};
+use crate::format::scres::IterationLog;
+use crate::format::setup::{LinearSolverChoice, NewtonSetup};
+use crate::solver::linear::{FaerDirect, FaerDirectOptions, LinearSolver, LinearSolverError, SymmetricStrategy, Symmetry};
+
+/// Why an increment did not converge.
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum IncrementFailure {
+    #[error("iteration {iteration}: element {element} inverted or failed ({error})")]
+    Element { iteration: u32, element: usize, error: ElementError },
+    #[error("did not converge in {iteration} iterations: relative residual {residual:.3e}, energy {energy:.3e}")]
+    NotConverged { iteration: u32, residual: f64, energy: f64 },
+    #[error("iteration {iteration}: diverged (relative residual {residual:.3e})")]
+    Diverged { iteration: u32, residual: f64 },
+    #[error("iteration {iteration}: linear solver: {error}")]
+    Linear { iteration: u32, error: LinearSolverError },
+}
+
+/// Setting the solver up failed (a mesh too large for the assembly's numbering, …).
+#[derive(Debug, thiserror::Error)]
+pub enum SetupFailure {
+    #[error(transparent)]
+    Pattern(#[from] PatternError),
+    #[error(transparent)]
+    Assembly(#[from] AssemblyError),
+    #[error(transparent)]
+    Linear(#[from] LinearSolverError),
+}
+
+/// Newton workspace for one problem: the pattern, its symbolic factorization and the
+/// buffers are built once and reused by every iteration of every increment.
+pub struct Newton<'p> {
+    pub problem: &'p Problem,
+    settings: NewtonSetup,
+    pattern: Pattern,
+    assembly: Assembly,
+    linear: Box<dyn LinearSolver>,
+    residual: Vec<f64>,
+    rhs: Vec<f64>,
+    r_free: Vec<f64>,
+}
+
+/// A converged increment's iteration history.
+pub struct Converged {
+    pub iterations: Vec<IterationLog>,
+}
+
+impl<'p> Newton<'p> {
+    pub fn new(problem: &'p Problem, settings: NewtonSetup, choice: LinearSolverChoice) -> Result<Self, SetupFailure> {
+        let groups: NodeGroups = problem.pressure_faces.iter().map(|f| &f.nodes[..]).collect();
+        let pattern = Pattern::build(problem.dofs.clone(), &problem.hexes, groups)?;
+        let assembly = Assembly::new(&pattern)?;
+        let (symmetry, strategy) = match choice {
+            LinearSolverChoice::Auto if problem.symmetric() => (Symmetry::Symmetric, SymmetricStrategy::LltThenLdlt),
+            LinearSolverChoice::Auto | LinearSolverChoice::Lu => (Symmetry::General, SymmetricStrategy::LltThenLdlt),
+            LinearSolverChoice::Cholesky => (Symmetry::Symmetric, SymmetricStrategy::Llt),
+            LinearSolverChoice::Ldlt => (Symmetry::Symmetric, SymmetricStrategy::Ldlt),
+        };
+        let mut linear: Box<dyn LinearSolver> = Box::new(FaerDirect::new(FaerDirectOptions { symmetric: strategy, ..Default::default() }));
+        linear.analyse(pattern.symbolic(), symmetry)?;
+        let n = DOFS_PER_NODE * problem.n_nodes();
+        let n_free = pattern.n_free();
+        Ok(Self { problem, settings, pattern, assembly, linear, residual: vec![0.0; n], rhs: vec![0.0; n_free], r_free: vec![0.0; n_free] })
+    }
+
+    pub fn n_free(&self) -> usize {
+        self.pattern.n_free()
+    }
+
+    pub fn nnz(&self) -> usize {
+        self.pattern.nnz()
+    }
+
+    pub fn linear_solver_name(&self) -> &str {
+        self.linear.name()
+    }
+
+    /// Assemble K_ff and the full residual R = f_int − f_ext(λ) at `u`.
+    fn assemble(&mut self, u: &[f64], lambda: f64) -> Result<(), (usize, ElementError)> {
+        let p = self.problem;
+        let hex = |e: usize, r: &mut _, k: &mut _| {
+            let (X, ue) = p.gather(e, u);
+            hex8_residual_tangent(&X, &ue, &p.materials[p.hex_material[e] as usize], p.formulation, r, k)
+        };
+        // Follower pressure: an external force, so the residual gets −f and the tangent −∂f/∂x.
+        let face = |g: usize, r: &mut DVector<f64>, k: &mut DMatrix<f64>| {
+            let f = &p.pressure_faces[g];
+            let x: [Vector3<f64>; 4] = std::array::from_fn(|a| {
+                let n = f.nodes[a] as usize;
+                let d = DOFS_PER_NODE * n;
+                p.X[n] + Vector3::new(u[d], u[d + 1], u[d + 2])
+            });
+            let (mut fv, mut km) = (FaceVector::zeros(), FaceMatrix::zeros());
+            follower_pressure_force_stiffness(&x, lambda * f.p, &mut fv, &mut km);
+            for i in 0..12 {
+                r[i] = -fv[i];
+                for j in 0..12 {
+                    k[(i, j)] = -km[(i, j)];
+                }
+            }
+            Ok(())
+        };
+        let res = self.assembly.assemble_with_groups(&self.pattern, hex, face);
+        let full = match res {
+            Ok((_, r)) => r,
+            Err(ElementFailure::Hex { element, error }) => return Err((element, error)),
+            Err(ElementFailure::Group { group, error }) => return Err((group, error)),
+        };
+        for ((out, r), f) in self.residual.iter_mut().zip(full).zip(&p.f_ext) {
+            *out = r - lambda * f;
+        }
+        Ok(())
+    }
+
+    /// Solve the increment at load factor `lambda`, starting from `u` (the previous
+    /// converged state), which is updated in place. `on_iteration` sees each row.
+    pub fn solve_increment(&mut self, lambda: f64, u: &mut [f64], on_iteration: &mut dyn FnMut(&IterationLog)) -> Result<Converged, IncrementFailure> {
+        let p = self.problem;
+        for &(d, v) in &p.prescribed {
+            u[d] = lambda * v;
+        }
+        let ext_norm = lambda.abs() * p.f_ext.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let mut log = Vec::new();
+        let mut energy0 = 0.0;
+        let mut energy = f64::INFINITY;
+        let mut first_residual = 0.0;
+        let mut max_reaction: f64 = 0.0;
+        for iteration in 0..=self.settings.max_iterations {
+            let t = Instant::now();
+            self.assemble(u, lambda).map_err(|(element, error)| IncrementFailure::Element { iteration, element, error })?;
+            let seconds_assembly = t.elapsed().as_secs_f64();
+            let dofs = &p.dofs;
+            dofs.gather_free(&self.residual, &mut self.rhs);
+            let r_norm = self.rhs.iter().map(|v| v * v).sum::<f64>().sqrt();
+            let reaction_norm = (0..self.residual.len()).filter(|&d| dofs.is_constrained(d)).map(|d| self.residual[d].powi(2)).sum::<f64>().sqrt();
+            // Reference force: the external load, or the largest reaction seen in this
+            // increment (a stress-free state, e.g. a prescribed rigid rotation, drives
+            // the current reaction itself to zero).
+            max_reaction = max_reaction.max(reaction_norm);
+            let reference = ext_norm.max(max_reaction);
+            let residual = if reference > 0.0 { r_norm / reference } else if r_norm == 0.0 { 0.0 } else { f64::INFINITY };
+            if !residual.is_finite() && r_norm != 0.0 && reference > 0.0 {
+                return Err(IncrementFailure::Diverged { iteration, residual });
+            }
+            if iteration == 0 {
+                first_residual = residual;
+            } else {
+                // Energy norm of the current state: the work of the residual R_i on the
+                // last correction Δu_{i-1}, relative to the first |Δu_0 · R_0|. Near the
+                // solution it falls like r_{i-1}·r_i, so it tracks the residual.
+                let e = self.r_free.iter().zip(&self.rhs).map(|(du, r)| du * r).sum::<f64>().abs();
+                energy = if energy0 > 0.0 { e / energy0 } else { 0.0 };
+            }
+            let converged = residual <= self.settings.residual_tolerance && (iteration == 0 || energy <= self.settings.energy_tolerance);
+            let mut row = IterationLog { iteration, residual, energy: if iteration == 0 { f64::NAN } else { energy }, seconds_assembly, seconds_factor: 0.0, seconds_solve: 0.0 };
+            if converged || r_norm == 0.0 {
+                on_iteration(&row);
+                log.push(row);
+                return Ok(Converged { iterations: log });
+            }
+            if iteration == self.settings.max_iterations {
+                on_iteration(&row);
+                log.push(row);
+                return Err(IncrementFailure::NotConverged { iteration, residual, energy });
+            }
+            if iteration >= 4 && residual > 1e6 * first_residual.max(self.settings.residual_tolerance) {
+                on_iteration(&row);
+                return Err(IncrementFailure::Diverged { iteration, residual });
+            }
+            let t = Instant::now();
+            self.linear.factor(self.assembly.values()).map_err(|error| IncrementFailure::Linear { iteration, error })?;
+            row.seconds_factor = t.elapsed().as_secs_f64();
+            let t = Instant::now();
+            // K_ff Δu_f = −R_f; Δu is kept in r_free for the next energy norm.
+            self.r_free.iter_mut().zip(&self.rhs).for_each(|(du, r)| *du = -r);
+            self.linear.solve_in_place(&mut self.r_free).map_err(|error| IncrementFailure::Linear { iteration, error })?;
+            row.seconds_solve = t.elapsed().as_secs_f64();
+            if iteration == 0 {
+                energy0 = self.r_free.iter().zip(&self.rhs).map(|(du, r)| du * r).sum::<f64>().abs();
+            }
+            dofs.add_free(&self.r_free, u);
+            on_iteration(&row);
+            log.push(row);
+        }
+        unreachable!("the loop returns at max_iterations")
+    }
+
+    /// Reaction force summed over each constrained node set at the last assembled state.
+    pub fn reactions(&self) -> Vec<(String, [f64; 3])> {
+        self.problem
+            .reaction_sets
+            .iter()
+            .map(|(name, nodes)| {
+                let mut f = [0.0; 3];
+                for &n in nodes {
+                    for (c, fc) in f.iter_mut().enumerate() {
+                        *fc += self.residual[DOFS_PER_NODE * n as usize + c];
+                    }
+                }
+                (name.clone(), f)
+            })
+            .collect()
+    }
+}
+
+/// Cauchy stress at the Gauss points of every element (row-major 3×3), in parallel.
+pub fn gauss_stresses(p: &Problem, u: &[f64]) -> Result<Vec<[[f64; 9]; 8]>, (usize, ElementError)> {
+    use rayon::prelude::*;
+    (0..p.hexes.len())
+        .into_par_iter()
+        .map(|e| {
+            let (X, ue) = p.gather(e, u);
+            let s = hex8_gauss_stresses(&X, &ue, &p.materials[p.hex_material[e] as usize]).map_err(|err| (e, err))?;
+            Ok(std::array::from_fn(|q| std::array::from_fn(|i| s[q][(i / 3, i % 3)])))
+        })
+        .collect()
+}

@@ -1,0 +1,230 @@
+//! The static boundary-value problem as the solver sees it, built from a mesh and a
+#![allow(non_snake_case)] // paper notation: X (reference coordinates)
+//! solve setup: a material per hexahedron, the Dirichlet dofs with their prescribed
+//! values, the reference external forces and the follower-pressure faces. Every
+//! reference to the mesh is checked here, so a bad setup fails before any solve with
+//! a message naming the set, body or value at fault.
+
+use nalgebra::Vector3;
+
+use crate::assembly::{DofMap, DOFS_PER_NODE};
+use crate::fem::element::Formulation;
+use crate::format::setup::{self, ModelName, SolveSetup};
+use crate::material::linear::LinearElastic;
+use crate::material::neo_hookean::{CiarletSimo, DevVolNeoHookean};
+use crate::material::{MaterialError, MaterialModel};
+use crate::mesh::Mesh;
+
+/// A setup that does not fit the mesh (or is invalid in itself).
+#[derive(Debug, thiserror::Error)]
+pub enum ProblemError {
+    #[error("{file}: {what} '{name}' does not exist in the mesh (it has: {available})")]
+    UnknownName { file: String, what: &'static str, name: String, available: String },
+    #[error("{file}: body '{body}' has no material (every body needs one entry under `materials`)")]
+    MissingMaterial { file: String, body: String },
+    #[error("{file}: body '{body}' has two materials")]
+    DuplicateMaterial { file: String, body: String },
+    #[error("{file}: material of body '{body}': {message}")]
+    MaterialParameters { file: String, body: String, message: String },
+    #[error("{file}: material of body '{body}': {source}")]
+    Material { file: String, body: String, source: MaterialError },
+    #[error("{file}: {message}")]
+    Invalid { file: String, message: String },
+}
+
+/// A follower pressure on one hexahedron face (nodes outward-oriented).
+#[derive(Debug, Clone, Copy)]
+pub struct PressureFace {
+    pub nodes: [u32; 4],
+    /// Pressure at load factor 1.
+    pub p: f64,
+}
+
+/// The problem.
+pub struct Problem {
+    /// Reference coordinates.
+    pub X: Vec<Vector3<f64>>,
+    pub hexes: Vec<[u32; 8]>,
+    /// Material of each hexahedron (index into `materials`).
+    pub hex_material: Vec<u32>,
+    pub materials: Vec<MaterialModel>,
+    pub formulation: Formulation,
+    pub dofs: DofMap,
+    /// (global dof, prescribed value at load factor 1).
+    pub prescribed: Vec<(usize, f64)>,
+    /// External nodal forces at load factor 1, length 3·nodes.
+    pub f_ext: Vec<f64>,
+    pub pressure_faces: Vec<PressureFace>,
+    /// Constrained node sets, for reaction output: (name, nodes).
+    pub reaction_sets: Vec<(String, Vec<u32>)>,
+}
+
+fn names(v: Vec<&str>) -> String {
+    if v.is_empty() {
+        "none".into()
+    } else {
+        v.join(", ")
+    }
+}
+
+fn material(file: &str, m: &setup::MaterialSetup) -> Result<MaterialModel, ProblemError> {
+    let bad = |message: String| ProblemError::MaterialParameters { file: file.into(), body: m.body.clone(), message };
+    let mat_err = |source| ProblemError::Material { file: file.into(), body: m.body.clone(), source };
+    let by_lame = match (m.e, m.nu, m.lambda, m.mu) {
+        (Some(_), Some(_), None, None) => false,
+        (None, None, Some(_), Some(_)) => true,
+        _ => return Err(bad("give either `E` and `nu`, or `lambda` and `mu`".into())),
+    };
+    for (name, v) in [("E", m.e), ("nu", m.nu), ("lambda", m.lambda), ("mu", m.mu)] {
+        if let Some(v) = v {
+            if !v.is_finite() {
+                return Err(bad(format!("`{name}` = {v} is not a finite number")));
+            }
+        }
+    }
+    let model: MaterialModel = match (m.model, by_lame) {
+        (ModelName::NeoHookean, false) => CiarletSimo::from_young_poisson(m.e.unwrap_or_default(), m.nu.unwrap_or_default()).map_err(mat_err)?.into(),
+        (ModelName::NeoHookean, true) => CiarletSimo::from_lame(m.lambda.unwrap_or_default(), m.mu.unwrap_or_default()).map_err(mat_err)?.into(),
+        (ModelName::NeoHookeanDevVol, false) => DevVolNeoHookean::from_young_poisson(m.e.unwrap_or_default(), m.nu.unwrap_or_default()).map_err(mat_err)?.into(),
+        (ModelName::NeoHookeanDevVol, true) => DevVolNeoHookean::from_lame(m.lambda.unwrap_or_default(), m.mu.unwrap_or_default()).map_err(mat_err)?.into(),
+        (ModelName::LinearElastic, false) => LinearElastic::from_young_poisson(m.e.unwrap_or_default(), m.nu.unwrap_or_default()).map_err(mat_err)?.into(),
+        (ModelName::LinearElastic, true) => LinearElastic::from_lame(m.lambda.unwrap_or_default(), m.mu.unwrap_or_default()).map_err(mat_err)?.into(),
+    };
+    Ok(model)
+}
+
+impl Problem {
+    /// Build and check the problem; `file` names the setup in messages.
+    pub fn new(mesh: &Mesh, setup: &SolveSetup, file: &str) -> Result<Self, ProblemError> {
+        let unknown = |what: &'static str, name: &str, available: Vec<&str>| ProblemError::UnknownName {
+            file: file.into(),
+            what,
+            name: name.into(),
+            available: names(available),
+        };
+        let invalid = |message: String| ProblemError::Invalid { file: file.into(), message };
+        // Materials: exactly one per body.
+        let mut body_material: Vec<Option<u32>> = vec![None; mesh.bodies.len()];
+        let mut materials = Vec::new();
+        for m in &setup.materials {
+            let b = mesh.body(&m.body).ok_or_else(|| unknown("body", &m.body, mesh.body_names()))?;
+            if body_material[b].is_some() {
+                return Err(ProblemError::DuplicateMaterial { file: file.into(), body: m.body.clone() });
+            }
+            body_material[b] = Some(materials.len() as u32);
+            materials.push(material(file, m)?);
+        }
+        let mut hex_material = Vec::with_capacity(mesh.hexes.len());
+        for &b in &mesh.hex_body {
+            match body_material[b as usize] {
+                Some(m) => hex_material.push(m),
+                None => return Err(ProblemError::MissingMaterial { file: file.into(), body: mesh.bodies[b as usize].name.clone() }),
+            }
+        }
+        // Dirichlet conditions.
+        let n = mesh.nodes.len();
+        let mut constrained = vec![false; DOFS_PER_NODE * n];
+        let mut value = vec![0.0; DOFS_PER_NODE * n];
+        let mut reaction_sets = Vec::new();
+        for c in &setup.constraints {
+            let set = mesh.node_set(&c.set).ok_or_else(|| unknown("node set", &c.set, mesh.node_set_names()))?;
+            let prescribed = c.displacement.as_ref().map(|d| d.as_array()).unwrap_or_default();
+            if c.fix.is_empty() && prescribed.iter().all(Option::is_none) {
+                return Err(invalid(format!("constraint on '{}' fixes nothing: give `fix` and/or `displacement`", c.set)));
+            }
+            for comp in &c.fix {
+                if prescribed[comp.index()].is_some() {
+                    return Err(invalid(format!("constraint on '{}': component {:?} is both fixed and prescribed", c.set, comp)));
+                }
+            }
+            for &node in &set.nodes {
+                for comp in &c.fix {
+                    let d = DOFS_PER_NODE * node as usize + comp.index();
+                    constrained[d] = true;
+                    value[d] = 0.0;
+                }
+                for (i, v) in prescribed.iter().enumerate() {
+                    if let Some(v) = v {
+                        if !v.is_finite() {
+                            return Err(invalid(format!("constraint on '{}': displacement is not finite", c.set)));
+                        }
+                        let d = DOFS_PER_NODE * node as usize + i;
+                        constrained[d] = true;
+                        value[d] = *v;
+                    }
+                }
+            }
+            reaction_sets.push((c.set.clone(), set.nodes.clone()));
+        }
+        let dofs = DofMap::from_constrained_mask(&constrained).map_err(|e| invalid(e.to_string()))?;
+        let prescribed = (0..constrained.len()).filter(|&d| constrained[d] && value[d] != 0.0).map(|d| (d, value[d])).collect();
+        // Loads.
+        let mut f_ext = vec![0.0; DOFS_PER_NODE * n];
+        let mut pressure_faces = Vec::new();
+        for (i, l) in setup.loads.iter().enumerate() {
+            match (&l.set, l.force, &l.face_set, l.pressure) {
+                (Some(s), Some(f), None, None) => {
+                    let set = mesh.node_set(s).ok_or_else(|| unknown("node set", s, mesh.node_set_names()))?;
+                    if f.iter().any(|v| !v.is_finite()) {
+                        return Err(invalid(format!("load {} on '{s}': force is not finite", i + 1)));
+                    }
+                    let share = if l.per_node { 1.0 } else { 1.0 / set.nodes.len() as f64 };
+                    for &node in &set.nodes {
+                        for c in 0..3 {
+                            f_ext[DOFS_PER_NODE * node as usize + c] += f[c] * share;
+                        }
+                    }
+                }
+                (None, None, Some(fs), Some(p)) => {
+                    let set = mesh.face_set(fs).ok_or_else(|| unknown("face set", fs, mesh.face_set_names()))?;
+                    if !p.is_finite() {
+                        return Err(invalid(format!("load {} on '{fs}': pressure is not finite", i + 1)));
+                    }
+                    pressure_faces.extend(set.faces.iter().map(|&f| PressureFace { nodes: mesh.face_nodes(f), p }));
+                }
+                _ => {
+                    return Err(invalid(format!(
+                        "load {}: give either `set` with `force` (and optionally `per_node`), or `face_set` with `pressure`",
+                        i + 1
+                    )))
+                }
+            }
+        }
+        Ok(Self {
+            X: mesh.nodes.iter().map(|p| Vector3::new(p[0], p[1], p[2])).collect(),
+            hexes: mesh.hexes.clone(),
+            hex_material,
+            materials,
+            formulation: match setup.formulation {
+                setup::Formulation::TotalLagrangian => Formulation::TotalLagrangian,
+                setup::Formulation::UpdatedLagrangian => Formulation::UpdatedLagrangian,
+            },
+            dofs,
+            prescribed,
+            f_ext,
+            pressure_faces,
+            reaction_sets,
+        })
+    }
+
+    pub fn n_nodes(&self) -> usize {
+        self.X.len()
+    }
+
+    /// The element's reference coordinates and displacements gathered from `u`.
+    #[inline]
+    pub fn gather(&self, e: usize, u: &[f64]) -> ([Vector3<f64>; 8], [Vector3<f64>; 8]) {
+        let h = &self.hexes[e];
+        let X = std::array::from_fn(|a| self.X[h[a] as usize]);
+        let ue = std::array::from_fn(|a| {
+            let d = DOFS_PER_NODE * h[a] as usize;
+            Vector3::new(u[d], u[d + 1], u[d + 2])
+        });
+        (X, ue)
+    }
+
+    /// True if the tangent is symmetric (no follower pressure).
+    pub fn symmetric(&self) -> bool {
+        self.pressure_faces.is_empty()
+    }
+}

@@ -1,0 +1,63 @@
+//! `sc-solve`: a mesh (`.scmesh`) and a solve setup → results (`.scres`) and a
+//! convergence-history CSV.
+
+use std::path::Path;
+use std::time::Instant;
+
+use super::StageRunError;
+use crate::format::scmesh;
+use crate::format::scres::{Results, RunStatus};
+use crate::format::setup::SolveSetup;
+use crate::solver::increments::{self, Outputs};
+use crate::solver::log::{SolveLog, Verbosity};
+use crate::solver::newton::Newton;
+use crate::solver::problem::Problem;
+
+/// What a finished solve reports.
+pub struct SolveReport {
+    pub increments: usize,
+    pub iterations: usize,
+    pub cutbacks: u32,
+    pub seconds: f64,
+}
+
+/// The CSV beside a results file: `results.scres` → `results.convergence.csv`.
+pub fn default_csv_path(output: &Path) -> Option<std::path::PathBuf> {
+    (output.as_os_str() != "-").then(|| output.with_extension("convergence.csv"))
+}
+
+/// Solve `setup` on the mesh in `input`, writing `output` after every converged
+/// increment and the convergence history to `csv`.
+pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, csv: Option<&Path>, verbosity: Verbosity) -> Result<SolveReport, StageRunError> {
+    if output.as_os_str() == "-" {
+        return Err(StageRunError::Usage("sc-solve writes its results after every increment: give a file with -o, not -".into()));
+    }
+    let start = Instant::now();
+    let mesh = scmesh::read(input)?;
+    let problem = Problem::new(&mesh, setup, setup_name)?;
+    let factors = setup.load_factors(setup_name)?;
+    let mut newton = Newton::new(&problem, setup.newton.clone(), setup.linear_solver)?;
+    let mut log = SolveLog::new(verbosity, factors.len());
+    log.line(&format!(
+        "{}: {} nodes, {} hexahedra, {} free dofs, {} nonzeros, {} increments, linear solver {}",
+        input.display(),
+        mesh.nodes.len(),
+        mesh.hexes.len(),
+        newton.n_free(),
+        newton.nnz(),
+        factors.len(),
+        newton.linear_solver_name()
+    ));
+    let mut results = Results {
+        source: input.display().to_string(),
+        setup: serde_yaml::to_string(setup).unwrap_or_default(),
+        status: RunStatus::Running,
+        increments: Vec::new(),
+        mesh,
+    };
+    let outputs = Outputs { results: output, csv };
+    let summary = increments::solve(&mut newton, &factors, setup.increments.max_cutbacks, &mut results, &outputs, &mut log);
+    log.finish();
+    let summary = summary?;
+    Ok(SolveReport { increments: summary.increments, iterations: summary.iterations, cutbacks: summary.cutbacks, seconds: start.elapsed().as_secs_f64() })
+}
