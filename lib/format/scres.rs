@@ -75,6 +75,8 @@ pub struct Increment {
 #[serde(deny_unknown_fields)]
 struct ResultsMeta {
     source: String,
+    /// `running`, `completed`, or `stopped: {reason: ...}` (not a YAML `!tag`).
+    #[serde(with = "serde_yaml::with::singleton_map")]
     status: RunStatus,
     /// The solve setup, as given (YAML text).
     setup: String,

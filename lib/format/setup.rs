@@ -37,9 +37,13 @@ pub struct MaterialSetup {
     pub model: ModelName,
     /// Young's modulus (give `E` and `nu`, or `lambda` and `mu`).
     #[serde(rename = "E")]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub e: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub nu: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub lambda: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub mu: Option<f64>,
 }
 
@@ -72,8 +76,11 @@ impl Component {
 #[derive(Debug, Clone, Default, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct Components {
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub x: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub y: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub z: Option<f64>,
 }
 
@@ -92,6 +99,7 @@ pub struct ConstraintSetup {
     #[serde(default)]
     pub fix: Vec<Component>,
     #[serde(default)]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub displacement: Option<Components>,
 }
 
@@ -100,12 +108,16 @@ pub struct ConstraintSetup {
 #[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct LoadSetup {
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub set: Option<String>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub force: Option<[f64; 3]>,
     #[serde(default)]
     pub per_node: bool,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub face_set: Option<String>,
     /// Follower pressure (positive pushes against the face's outward normal).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub pressure: Option<f64>,
 }
 
@@ -113,7 +125,9 @@ pub struct LoadSetup {
 #[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct IncrementSetup {
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub count: Option<u32>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub factors: Option<Vec<f64>>,
     /// How many times an increment may be halved before the solve stops.
     #[serde(default = "default_cutbacks")]

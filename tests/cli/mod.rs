@@ -1,3 +1,4 @@
 mod bad_input;
 mod import_export;
 mod pipeline;
+mod solve;

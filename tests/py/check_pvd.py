@@ -1,0 +1,47 @@
+"""Independent check of a .pvd written by sc-export from a results file.
+
+usage: check_pvd.py RESULTS.pvd
+Parses the collection, reads every .vtu it lists with meshio and asserts the fields
+ParaView users rely on: point data displacement (n,3), stress (n,9), von_mises,
+principal_max >= principal_min; cell data body and stress. Prints one JSON line with
+the number of steps, the time values and max |u| of the last step per component.
+"""
+import json
+import os
+import sys
+import xml.etree.ElementTree as ET
+
+import meshio
+import numpy as np
+
+
+def main():
+    pvd = sys.argv[1]
+    root = ET.parse(pvd).getroot()
+    assert root.attrib["type"] == "Collection", "not a VTK collection"
+    entries = [(float(d.attrib["timestep"]), d.attrib["file"]) for d in root.iter("DataSet")]
+    assert entries, "empty collection"
+    times = [t for t, _ in entries]
+    assert times == sorted(times), f"time steps not increasing: {times}"
+    last = None
+    for t, f in entries:
+        m = meshio.read(os.path.join(os.path.dirname(pvd), f))
+        n = len(m.points)
+        u = np.asarray(m.point_data["displacement"])
+        assert u.shape == (n, 3), f"{f}: displacement shape {u.shape}"
+        s = np.asarray(m.point_data["stress"])
+        assert s.shape == (n, 9), f"{f}: stress shape {s.shape}"
+        vm = np.asarray(m.point_data["von_mises"]).ravel()
+        pmax = np.asarray(m.point_data["principal_max"]).ravel()
+        pmin = np.asarray(m.point_data["principal_min"]).ravel()
+        assert np.all(vm >= 0) and np.all(pmax >= pmin - 1e-12 * (1 + abs(pmin))), f"{f}: stress measures inconsistent"
+        for key in ("body", "stress", "von_mises"):
+            assert key in m.cell_data, f"{f}: cell data {key} missing"
+        if t == 0.0:
+            assert np.all(u == 0.0), "step 0 must be the undeformed state"
+        last = u
+    print(json.dumps({"steps": len(entries), "times": times, "max_abs_u": np.abs(last).max(axis=0).tolist()}))
+
+
+if __name__ == "__main__":
+    main()
