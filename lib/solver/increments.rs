@@ -4,6 +4,8 @@
 //! converged increment is written to the results file as soon as it converges, so a
 //! stopped run keeps all of them on disk.
 
+#![allow(non_snake_case)] // paper notation: X (reference coordinates)
+
 use std::path::Path;
 use std::time::Instant;
 
@@ -11,6 +13,7 @@ use super::log::{IterationEvent, SolveLog};
 use super::newton::{gauss_stresses, IncrementFailure, Newton};
 use super::problem::Problem;
 use crate::assembly::DOFS_PER_NODE;
+use crate::fem::element::hex8_min_jacobian;
 use crate::format::scres::{Increment, IncrementInfo, Reaction, Results, RunStatus};
 use crate::format::stage::{write_atomic, StageError};
 
@@ -45,13 +48,24 @@ pub struct Outputs<'a> {
     pub csv: Option<&'a Path>,
 }
 
-fn worst_element(results: &Results, failure: &IncrementFailure) -> String {
+/// The element to look at: the failing one, or else the one with the smallest
+/// volume ratio J at the last (failed) iterate.
+fn worst_element(p: &Problem, results: &Results, failure: &IncrementFailure, trial: &[f64]) -> String {
+    let tag = |e: usize| results.mesh.element_tags.get(e).copied().unwrap_or_default();
     match failure {
-        IncrementFailure::Element { element, .. } => {
-            let tag = results.mesh.element_tags.get(*element).copied().unwrap_or_default();
-            format!(" (worst element: hexahedron {element}, gmsh tag {tag})")
+        IncrementFailure::Element { element, .. } => format!(" (worst element: hexahedron {element}, gmsh tag {})", tag(*element)),
+        _ => {
+            let worst = (0..p.hexes.len())
+                .filter_map(|e| {
+                    let (X, ue) = p.gather(e, trial);
+                    hex8_min_jacobian(&X, &ue).ok().map(|j| (e, j))
+                })
+                .min_by(|a, b| a.1.total_cmp(&b.1));
+            match worst {
+                Some((e, j)) => format!(" (worst element: hexahedron {e}, gmsh tag {}, smallest J = {j:.4} at the last iterate)", tag(e)),
+                None => String::new(),
+            }
         }
-        _ => String::new(),
     }
 }
 
@@ -102,7 +116,7 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
                         Ok(s) => s,
                         Err((element, error)) => {
                             let failure = IncrementFailure::Element { iteration: 0, element, error };
-                            return Err(stop(results, out, log, k + 1, lambda, lambda_prev, cutbacks_this, failure));
+                            return Err(stop(p, &trial, results, out, log, k + 1, lambda, lambda_prev, cutbacks_this, failure));
                         }
                     };
                     summary.iterations += conv.iterations.len().saturating_sub(1);
@@ -133,7 +147,7 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
                 Err(failure) => {
                     failures += 1;
                     if failures > max_cutbacks {
-                        return Err(stop(results, out, log, k + 1, lambda, lambda_prev, cutbacks_this, failure));
+                        return Err(stop(p, &trial, results, out, log, k + 1, lambda, lambda_prev, cutbacks_this, failure));
                     }
                     cutbacks_this += 1;
                     summary.cutbacks += 1;
@@ -151,8 +165,8 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
 }
 
 #[allow(clippy::too_many_arguments)]
-fn stop(results: &mut Results, out: &Outputs, log: &SolveLog, increment: usize, load_factor: f64, last_converged: f64, cutbacks: u32, failure: IncrementFailure) -> SolveError {
-    let worst = worst_element(results, &failure);
+fn stop(p: &Problem, trial: &[f64], results: &mut Results, out: &Outputs, log: &SolveLog, increment: usize, load_factor: f64, last_converged: f64, cutbacks: u32, failure: IncrementFailure) -> SolveError {
+    let worst = worst_element(p, results, &failure, trial);
     let reason = format!("increment {increment} at load factor {load_factor:.6}: {failure}{worst}");
     results.status = RunStatus::Stopped { reason };
     if let Err(e) = results.write(out.results) {

@@ -62,7 +62,7 @@ fn stopped_solve_keeps_converged_increments() {
     let o = run("sc-solve", &["c.scmesh", "--setup", "setup.yaml", "-o", "r.scres"], dir.path());
     let err = stderr(&o);
     assert_eq!(o.status.code(), Some(3), "{err}");
-    assert!(err.contains("solve stopped at increment 2") && err.contains("converged increments are in r.scres"), "{err}");
+    assert!(err.contains("worst element: hexahedron") && err.contains("gmsh tag") && err.contains("solve stopped at increment 2") && err.contains("converged increments are in r.scres"), "{err}");
     let o = run("sc-export", &["r.scres", "--format", "yaml", "-o", "-"], dir.path());
     let yaml = String::from_utf8_lossy(&o.stdout);
     assert!(yaml.contains("stopped:") && yaml.contains("reason:"), "{yaml}");

@@ -214,7 +214,9 @@ fn cantilever_coarse_locking_is_measured() {
     // severe there. Pin the measured ratio so a change in the element is noticed.
     let (uz, theory) = cantilever_tip([15, 2, 2]);
     let ratio = uz / theory;
-    assert!(ratio > 0.5 && ratio < 0.99, "coarse ratio {ratio}");
+    // Measured 0.8174: hex8 full integration, 2 elements deep (as the paper's beams),
+    // is 18 % too stiff. ±0.01 pins it: any change of the element formulation shows.
+    assert!((ratio - 0.8174).abs() < 0.01, "coarse ratio {ratio}");
     eprintln!("coarse cantilever 15x2x2: deflection ratio {ratio:.4}");
 }
 
