@@ -8,11 +8,16 @@
 //! `#[ignore]`d test below prints a table (`cargo test --release --lib
 //! bench_table -- --ignored --nocapture`).
 
+#![allow(non_snake_case)] // paper notation: X (reference coordinates)
+
 use std::time::{Duration, Instant};
 
-use nalgebra::{Matrix3, SMatrix, Vector3};
+use nalgebra::Vector3;
 
-use crate::assembly::{Assembly, AssemblyError, DofMap, HexMatrix, NodeGroups, Pattern, PatternError};
+use crate::assembly::{Assembly, AssemblyError, DofMap, HexMatrix, HexVector, NodeGroups, Pattern, PatternError};
+use crate::fem::element::{hex8_residual_tangent, Formulation};
+use crate::material::linear::LinearElastic;
+use crate::material::MaterialModel;
 use crate::assembly::pattern::structured_hex_grid;
 
 use super::linear::{Factorization, LinearSolver, LinearSolverError, Symmetry};
@@ -54,73 +59,15 @@ pub struct BenchTimings {
     pub relative_residual: f64,
 }
 
-/// Linear-elastic isotropic constitutive matrix (Voigt: xx, yy, zz, xy, yz, xz;
-/// engineering shear strains).
-fn elasticity_matrix(young: f64, nu: f64) -> SMatrix<f64, 6, 6> {
-    let lambda = young * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
-    let mu = young / (2.0 * (1.0 + nu));
-    let mut d = SMatrix::<f64, 6, 6>::zeros();
-    for i in 0..3 {
-        for j in 0..3 {
-            d[(i, j)] = lambda;
-        }
-        d[(i, i)] += 2.0 * mu;
-        d[(i + 3, i + 3)] = mu;
-    }
-    d
-}
-
-/// Small-strain stiffness `K_e = Σ_q Bᵀ D B det J w_q` of a hex8 (VTK node order,
-/// 2×2×2 Gauss). `None` if a Gauss-point Jacobian is not positive.
+/// Small-strain stiffness of a hex8 (VTK node order, 2×2×2 Gauss): the tangent of
+/// the library's element ([`crate::fem::element`]) with a linear-elastic material at
+/// u = 0. `None` if the element is degenerate or the parameters are invalid.
 pub fn hex8_elastic_stiffness(x: &[[f64; 3]; 8], young: f64, nu: f64) -> Option<HexMatrix> {
-    const XI: [[f64; 3]; 8] = [
-        [-1.0, -1.0, -1.0],
-        [1.0, -1.0, -1.0],
-        [1.0, 1.0, -1.0],
-        [-1.0, 1.0, -1.0],
-        [-1.0, -1.0, 1.0],
-        [1.0, -1.0, 1.0],
-        [1.0, 1.0, 1.0],
-        [-1.0, 1.0, 1.0],
-    ];
-    let d = elasticity_matrix(young, nu);
-    let g = 1.0 / 3f64.sqrt();
-    let mut k = HexMatrix::zeros();
-    for q in XI.iter() {
-        let (xi, eta, zeta) = (g * q[0], g * q[1], g * q[2]);
-        let mut dn = [Vector3::zeros(); 8];
-        for (a, na) in XI.iter().enumerate() {
-            dn[a] = Vector3::new(
-                na[0] * (1.0 + eta * na[1]) * (1.0 + zeta * na[2]),
-                na[1] * (1.0 + xi * na[0]) * (1.0 + zeta * na[2]),
-                na[2] * (1.0 + xi * na[0]) * (1.0 + eta * na[1]),
-            ) / 8.0;
-        }
-        let mut jac = Matrix3::zeros();
-        for (xa, dna) in x.iter().zip(&dn) {
-            jac += Vector3::from(*xa) * dna.transpose();
-        }
-        let det = jac.determinant();
-        if det <= 0.0 {
-            return None;
-        }
-        let jinv_t = jac.try_inverse()?.transpose();
-        let mut b = SMatrix::<f64, 6, 24>::zeros();
-        for (a, dna) in dn.iter().enumerate() {
-            let gr = jinv_t * dna;
-            let c = 3 * a;
-            b[(0, c)] = gr[0];
-            b[(1, c + 1)] = gr[1];
-            b[(2, c + 2)] = gr[2];
-            b[(3, c)] = gr[1];
-            b[(3, c + 1)] = gr[0];
-            b[(4, c + 1)] = gr[2];
-            b[(4, c + 2)] = gr[1];
-            b[(5, c)] = gr[2];
-            b[(5, c + 2)] = gr[0];
-        }
-        k += b.transpose() * (d * b) * det;
-    }
+    let mat: MaterialModel = LinearElastic::from_young_poisson(young, nu).ok()?.into();
+    let X: [Vector3<f64>; 8] = std::array::from_fn(|a| Vector3::new(x[a][0], x[a][1], x[a][2]));
+    let u = [Vector3::zeros(); 8];
+    let (mut r, mut k) = (HexVector::zeros(), HexMatrix::zeros());
+    hex8_residual_tangent(&X, &u, &mat, Formulation::TotalLagrangian, &mut r, &mut k).ok()?;
     Some(k)
 }
 
