@@ -18,7 +18,7 @@ use splinecontact::stages::solve;
 ///   constraints: [{set: base, fix: [x, y, z]}, {set: top, displacement: {z: -1.0}}]
 ///   loads:       [{set: tip, force: [0, 0, -10]}, {face_set: top, pressure: 2.0}]
 ///   increments:  {count: 10, max_cutbacks: 5}
-///   newton:      {max_iterations: 25, residual_tolerance: 1.0e-8, energy_tolerance: 1.0e-16}
+///   newton:      {max_iterations: 25, residual_tolerance: 1.0e-8, energy_tolerance: 1.0e-12}
 ///
 /// The results file (.scres) is rewritten after every converged increment, so a run
 /// that stops keeps everything it converged. The convergence history goes to a CSV

@@ -152,7 +152,8 @@ pub struct NewtonSetup {
     /// ‖R_free‖ ≤ tol · max(‖F_ext‖, ‖reactions‖, tiny).
     #[serde(default = "default_residual_tol")]
     pub residual_tolerance: f64,
-    /// |Δu · R| ≤ tol · (Δu₀ · R₀) of the increment's first iteration.
+    /// |Δu_{i−1} · R_i| ≤ tol · |Δu_0 · R_0|; falls like r_{i−1}·r_i near the solution,
+    /// so 1e-12 matches a residual tolerance of 1e-8.
     #[serde(default = "default_energy_tol")]
     pub energy_tolerance: f64,
 }
@@ -164,7 +165,7 @@ fn default_residual_tol() -> f64 {
     1e-8
 }
 fn default_energy_tol() -> f64 {
-    1e-16
+    1e-12
 }
 
 impl Default for NewtonSetup {
