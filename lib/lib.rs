@@ -22,6 +22,7 @@
 //! | ξ̄^α, ā_α, ā_αβ, b̄_αβ | `xi`, `a_alpha`, `a_ab`, `b_ab` | 4.10–4.13 |
 
 pub mod assembly;
+pub mod contact;
 pub mod fem;
 pub mod format;
 pub mod material;
