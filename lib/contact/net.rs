@@ -24,7 +24,7 @@
 //!    the other way, j is flipped (ā_2 → −ā_2); a mix of both is an inconsistently
 //!    oriented face set and refused.
 
-use std::collections::{BTreeMap, HashMap};
+use std::collections::{BTreeMap, HashSet};
 
 use crate::mesh::{HexFace, Mesh};
 
@@ -138,16 +138,16 @@ pub fn control_net(mesh: &Mesh, name: &str) -> Result<ControlNet, NetError> {
             what: format!("boundary node {} is where {} boundary edges meet (faces touching only at a corner: {})", tag(n), nb.len(), describe_all(mesh, set, &node_faces[&n])),
         });
     }
-    let mut seen: HashMap<u32, ()> = HashMap::new();
+    let mut seen: HashSet<u32> = HashSet::new();
     let mut loops = 0;
     for &start in bnd.keys() {
-        if seen.contains_key(&start) {
+        if seen.contains(&start) {
             continue;
         }
         loops += 1;
         let (mut prev, mut cur) = (start, start);
         loop {
-            seen.insert(cur, ());
+            seen.insert(cur);
             let nb = &bnd[&cur];
             let next = if nb[0] != prev { nb[0] } else { nb[1] };
             prev = cur;
@@ -163,10 +163,10 @@ pub fn control_net(mesh: &Mesh, name: &str) -> Result<ControlNet, NetError> {
 
     // 4. Corners, re-entrant corners, interior valence.
     let corners: Vec<u32> = bnd.keys().copied().filter(|n| node_faces[n].len() == 1).collect();
-    if let Some(n) = bnd.keys().find(|n| node_faces[n].len() > 2) {
+    if let Some(n) = bnd.keys().copied().find(|n| node_faces[n].len() > 2) {
         return Err(NetError::NonRectangular {
             set: set_name,
-            what: format!("boundary node {} is a re-entrant corner in {} faces ({})", tag(*n), node_faces[n].len(), describe_all(mesh, set, &node_faces[n])),
+            what: format!("boundary node {} is a re-entrant corner in {} faces ({})", tag(n), node_faces[&n].len(), describe_all(mesh, set, &node_faces[&n])),
         });
     }
     if corners.len() != 4 {
@@ -176,7 +176,7 @@ pub fn control_net(mesh: &Mesh, name: &str) -> Result<ControlNet, NetError> {
             what: format!("{} corner nodes (nodes in exactly one face: {}), a rectangle has 4", corners.len(), list.join(", ")),
         });
     }
-    if let Some((&n, fs)) = node_faces.iter().find(|(n, fs)| !bnd.contains_key(n) && fs.len() != 4) {
+    if let Some((&n, fs)) = node_faces.iter().find(|(n, fs)| !bnd.contains_key(*n) && fs.len() != 4) {
         return Err(NetError::IrregularInterior { set: set_name, node: tag(n), count: fs.len(), faces: describe_all(mesh, set, fs) });
     }
 
@@ -217,7 +217,7 @@ pub fn control_net(mesh: &Mesh, name: &str) -> Result<ControlNet, NetError> {
             let Some(&k) = candidates.iter().find(|&&k| !used[k] && quads[k].contains(&p01) && quads[k].contains(&p00)) else {
                 return Err(not_grid(format!("no face continues the grid at nodes {}, {}, {}", tag(p00), tag(p10), tag(p01))));
             };
-            let Some(&p11) = quads[k].iter().find(|n| ![p00, p10, p01].contains(n)) else {
+            let Some(&p11) = quads[k].iter().find(|n| ![p00, p10, p01].contains(*n)) else {
                 return Err(not_grid(format!("{} is degenerate", describe(mesh, set, k))));
             };
             let slot = &mut nodes[i + 1 + a * (j + 1)];
@@ -353,9 +353,8 @@ mod tests {
 
     #[test]
     fn branch_is_refused() {
-        // Top faces of a 2×1 slab plus a third face (a side face of hex 0) on the
-        // shared edge x = 1? The side faces of hex 0 with x = 1 is local 3: it shares
-        // the edge (1,0,1)–(1,1,1) with both top faces.
+        // Top faces of a 2×1 slab plus the interior face between the two hexes
+        // (hex 0's local face 3, x = 1): three faces on the edge (1,0,1)–(1,1,1).
         let mut m = slab(2, 1, |_, _| true);
         m.face_sets[0].faces.push(HexFace { element: 0, local: 3 });
         m.face_sets[0].quad_tags.push(77);

@@ -137,25 +137,32 @@ pub fn write_contact_vtu(model: &ContactModel, output: &Path) -> Result<String, 
 pub fn master_surface_grid(p: &ContactPair, x: &[Vec3]) -> Result<vtk::Grid, StageRunError> {
     let bad = |e: crate::spline::SplineError| StageRunError::Usage(format!("pair '{}': {e}", p.name));
     let (a, b) = (p.net.a, p.net.b);
-    let (spans, eval): ([usize; 2], Box<dyn Fn([usize; 2], [f64; 2]) -> SurfacePoint>) = match p.master_kind {
+    enum Master {
+        Bspline(BSplinePatch),
+        Facet(FacetSurface),
+    }
+    let master = match p.master_kind {
         MasterKind::Bspline => {
             let patch = BSplinePatch::new(a, b, p.orders[0], p.orders[1]).map_err(bad)?;
             patch.check_control_net(x).map_err(bad)?;
-            let spans = patch.n_spans();
-            (spans, Box::new(move |_, xi| patch.evaluate(x, xi)))
+            Master::Bspline(patch)
         }
         MasterKind::Facet => {
             let f = FacetSurface::new(a, b).map_err(bad)?;
             f.check_control_net(x).map_err(bad)?;
-            let spans = f.n_cells();
-            (
-                spans,
-                Box::new(move |cell, xi| {
-                    let mut out = SurfacePoint::default();
-                    f.evaluate_in_cell_into(x, cell, xi, &mut out);
-                    out
-                }),
-            )
+            Master::Facet(f)
+        }
+    };
+    let spans = match &master {
+        Master::Bspline(patch) => patch.n_spans(),
+        Master::Facet(f) => f.n_cells(),
+    };
+    let eval = |cell: [usize; 2], xi: [f64; 2]| match &master {
+        Master::Bspline(patch) => patch.evaluate(x, xi),
+        Master::Facet(f) => {
+            let mut out = SurfacePoint::default();
+            f.evaluate_in_cell_into(x, cell, xi, &mut out);
+            out
         }
     };
     let s = SUBDIVISIONS;
