@@ -390,4 +390,44 @@ mod tests {
         let e = control_net(&m, "top").unwrap_err().to_string();
         assert!(e.contains("inconsistently oriented"), "{e}");
     }
+
+    /// A surface of arbitrary quads: each quad is face 1 (nodes 4..8) of a stand-in
+    /// hexahedron (only the face topology matters to the net).
+    fn quad_surface(nodes: Vec<[f64; 3]>, quads: &[[u32; 4]]) -> Mesh {
+        let hexes: Vec<[u32; 8]> = quads.iter().map(|q| [q[0], q[1], q[2], q[3], q[0], q[1], q[2], q[3]]).collect();
+        let m = hexes.len();
+        Mesh {
+            node_tags: (1..=nodes.len() as u64).collect(),
+            nodes,
+            hexes,
+            hex_body: vec![0; m],
+            bodies: vec![Body { name: "b".into(), physical_tag: 1 }],
+            node_sets: vec![],
+            face_sets: vec![FaceSet {
+                name: "s".into(),
+                physical_tag: 1,
+                faces: (0..m as u32).map(|e| HexFace { element: e, local: 1 }).collect(),
+                quad_tags: (1..=m as u64).collect(),
+            }],
+            element_tags: (1..=m as u64).collect(),
+        }
+    }
+
+    #[test]
+    fn irregular_interior_is_refused() {
+        // A 2×2 square whose top-right quad is split into three around P: the outline
+        // is a rectangle with 4 corners, but P is in 3 faces and O in 5.
+        let nodes = vec![
+            [0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0], [2.0, 1.0, 0.0],
+            [0.0, 2.0, 0.0], [1.0, 2.0, 0.0], [2.0, 2.0, 0.0], [2.0, 1.5, 0.0], [1.5, 2.0, 0.0], [1.5, 1.5, 0.0],
+        ];
+        let quads = [[0, 1, 4, 3], [1, 2, 5, 4], [3, 4, 7, 6], [4, 5, 9, 11], [11, 9, 8, 10], [4, 11, 10, 7]];
+        let m = quad_surface(nodes, &quads);
+        let e = control_net(&m, "s").unwrap_err().to_string();
+        assert!(e.contains("not a regular grid: interior node 5 (gmsh tag) is in 5 faces"), "{e}");
+        // The regular 2×2 square on the same nodes is accepted.
+        let m = quad_surface(m.nodes.clone(), &[[0, 1, 4, 3], [1, 2, 5, 4], [3, 4, 7, 6], [4, 5, 8, 7]]);
+        let net = control_net(&m, "s").unwrap();
+        assert_eq!((net.a, net.b, net.nodes.clone()), (3, 3, (0..9).collect::<Vec<u32>>()));
+    }
 }
