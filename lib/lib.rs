@@ -10,6 +10,8 @@
 //! |----------|---------------|
 //! | `format` | on-disk formats: stage container, `.scmesh`, gmsh MSH, VTK, pipeline YAML |
 //! | `mesh`   | the mesh: nodes, hex8, bodies, node and face sets, hex8 topology |
+//! | `contact` | contact pairs: a master face set ordered into the B-spline control net |
+//! | `spline` | the B-spline master patch and its bilinear-facet counterpart |
 //! | `stages` | each pipeline stage as a library call (the binaries are thin wrappers) |
 //! | `pipeline` | the YAML pipeline runner |
 //!
@@ -22,6 +24,7 @@
 //! | ξ̄^α, ā_α, ā_αβ, b̄_αβ | `xi`, `a_alpha`, `a_ab`, `b_ab` | 4.10–4.13 |
 
 pub mod assembly;
+pub mod contact;
 pub mod fem;
 pub mod format;
 pub mod material;

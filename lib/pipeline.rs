@@ -62,6 +62,14 @@ pub fn run(path: &Path, verbosity: Verbosity, log: &mut dyn FnMut(&str)) -> Resu
                     log(&format!("      {line}"));
                 }
             }
+            Stage::Tag(s) => {
+                let (input, out) = (resolve(&base, &s.input), resolve(&base, &s.output));
+                log(&format!("[{index}/{n}] tag {} -> {}", input.display(), out.display()));
+                ensure_parent(&out).map_err(fail)?;
+                for line in stages::tag::tag(&input, &out, &s.pairs).map_err(fail)? {
+                    log(&format!("      {line}"));
+                }
+            }
             Stage::Solve(s) => {
                 let (input, out) = (resolve(&base, &s.input), resolve(&base, &s.output));
                 log(&format!("[{index}/{n}] solve {} -> {}", input.display(), out.display()));

@@ -3,6 +3,7 @@
 
 pub mod msh;
 pub mod pipeline;
+pub mod sccontact;
 pub mod scmesh;
 pub mod scres;
 pub mod setup;

@@ -5,6 +5,10 @@
 //! name: parisch                  # optional, for messages
 //! stages:
 //!   - import: { input: ../meshes/parisch.msh, output: out/parisch.scmesh }
+//!   - tag:
+//!       input: out/parisch.scmesh
+//!       output: out/parisch.sccontact
+//!       pairs: [{name: contact, slave: upper_bottom, master: lower_top, master_kind: bspline, orders: [3, 3]}]
 //!   - export: { input: out/parisch.scmesh, output: out/parisch.vtu }
 //! ```
 //! Every struct denies unknown keys, so a misspelt key is an error that names it
@@ -17,6 +21,7 @@ use serde::Deserialize;
 use crate::stages::export::ExportFormat;
 use crate::format::setup::SolveSetup;
 use crate::stages::gmsh::MshFlavour;
+use crate::stages::tag::PairSpec;
 
 /// The pipeline versions this build reads.
 pub const VERSION: u32 = 1;
@@ -40,6 +45,7 @@ pub struct Pipeline {
 pub enum Stage {
     Gmsh(GmshStage),
     Import(ImportStage),
+    Tag(TagStage),
     Solve(SolveStage),
     Export(ExportStage),
 }
@@ -49,6 +55,7 @@ impl Stage {
         match self {
             Self::Gmsh(_) => "gmsh",
             Self::Import(_) => "import",
+            Self::Tag(_) => "tag",
             Self::Solve(_) => "solve",
             Self::Export(_) => "export",
         }
@@ -73,6 +80,16 @@ pub struct GmshStage {
 pub struct ImportStage {
     pub input: PathBuf,
     pub output: PathBuf,
+}
+
+/// Tag: contact pairs on a mesh → contact model (`.sccontact`).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TagStage {
+    pub input: PathBuf,
+    pub output: PathBuf,
+    /// `[{name, slave, master, master_kind, orders}, …]`.
+    pub pairs: Vec<PairSpec>,
 }
 
 /// Solve: the setup inline (`setup:`) or in a file (`setup_file:`).
@@ -161,6 +178,18 @@ mod tests {
         let e = Pipeline::parse("p.yaml", y).unwrap_err().to_string();
         assert!(e.contains("binary") || e.contains("boolean"), "{e}");
         assert!(e.contains("line 3"), "{e}");
+    }
+
+    #[test]
+    fn tag_stage_parses() {
+        let y = "version: 1\nstages:\n  - tag:\n      input: a.scmesh\n      output: a.sccontact\n      pairs:\n        - {name: c, slave: s, master: m, master_kind: facet}\n        - {name: d, slave: s, master: m, orders: [4, 2]}\n";
+        let p = Pipeline::parse("p.yaml", y).unwrap();
+        let Stage::Tag(t) = &p.stages[0] else { panic!("not a tag stage") };
+        assert_eq!(t.pairs.len(), 2);
+        assert_eq!(t.pairs[1].orders, Some([4, 2]));
+        let bad = y.replace("master_kind: facet", "master_kind: nurbs");
+        let e = Pipeline::parse("p.yaml", &bad).unwrap_err().to_string();
+        assert!(e.contains("nurbs") && e.contains("line 7"), "{e}");
     }
 
     #[test]

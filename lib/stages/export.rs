@@ -5,7 +5,9 @@ use std::path::Path;
 use super::StageRunError;
 use crate::format::stage::{write_atomic_with, StageFile};
 use crate::format::scres::Results;
-use crate::format::{scmesh, scres, vtk};
+use crate::format::sccontact::{ContactModel, ContactPair, MasterKind};
+use crate::format::{sccontact, scmesh, scres, vtk};
+use crate::spline::{BSplinePatch, FacetSurface, SurfacePoint, Vec3};
 use crate::post::stresses;
 
 /// Output formats of `sc-export`.
@@ -44,7 +46,7 @@ pub fn export(input: &Path, output: &Path, format: Option<ExportFormat>) -> Resu
             )))
         }
     };
-    let file = StageFile::read_known(input, &[(scmesh::FORMAT, scmesh::MAJOR), (scres::FORMAT, scres::MAJOR)])?;
+    let file = StageFile::read_known(input, &[(scmesh::FORMAT, scmesh::MAJOR), (scres::FORMAT, scres::MAJOR), (sccontact::FORMAT, sccontact::MAJOR)])?;
     match format {
         ExportFormat::Yaml => {
             write_atomic_with(output, |w| file.dump_yaml(w))?;
@@ -57,7 +59,11 @@ pub fn export(input: &Path, output: &Path, format: Option<ExportFormat>) -> Resu
                 vtk::mesh_grid(&mesh).write_vtu(output)?;
                 Ok(format!("wrote {} ({n} points, {m} hexahedra)", output.display()))
             }
-            other => Err(StageRunError::Usage(format!("{}: a '{other}' file cannot be exported as .vtu (supported: scmesh)", input.display()))),
+            sccontact::FORMAT => {
+                let model = ContactModel::from_stage(&file)?;
+                write_contact_vtu(&model, output)
+            }
+            other => Err(StageRunError::Usage(format!("{}: a '{other}' file cannot be exported as .vtu (supported: scmesh, sccontact)", input.display()))),
         },
         ExportFormat::Pvd => match file.format.as_str() {
             scres::FORMAT => {
@@ -97,6 +103,121 @@ pub fn write_results_pvd(results: &Results, output: &Path) -> Result<String, Sta
     }
     vtk::write_pvd(output, &entries)?;
     Ok(format!("wrote {} ({} increments + the undeformed state)", output.display(), results.increments.len()))
+}
+
+/// Sub-quads per knot span (B-spline) or facet, per direction, in the tessellated
+/// master surface.
+pub const SUBDIVISIONS: usize = 8;
+
+/// A contact model: the mesh as `output`, and per pair `<stem>_<pair>_surface.vtu`
+/// (the master surface tessellated, point data `normal` = n̄ and `xi` = (ξ¹, ξ², 0))
+/// and `<stem>_<pair>_net.vtu` (the control net as lines through the nodes).
+pub fn write_contact_vtu(model: &ContactModel, output: &Path) -> Result<String, StageRunError> {
+    if output.as_os_str() == "-" {
+        return Err(StageRunError::Usage("a contact model exports to several .vtu files; give a file name, not -".into()));
+    }
+    let stem = output.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "contact".into());
+    let dir = output.parent().filter(|p| !p.as_os_str().is_empty()).map(Path::to_path_buf).unwrap_or_default();
+    let mut written = vec![output.display().to_string()];
+    vtk::mesh_grid(&model.mesh).write_vtu(output)?;
+    for p in &model.pairs {
+        let x: Vec<Vec3> = p.net.nodes.iter().map(|&n| Vec3::from(model.mesh.nodes[n as usize])).collect();
+        let surface = dir.join(format!("{stem}_{}_surface.vtu", p.name));
+        master_surface_grid(p, &x)?.write_vtu(&surface)?;
+        let net = dir.join(format!("{stem}_{}_net.vtu", p.name));
+        control_net_grid(p, &x, &model.mesh).write_vtu(&net)?;
+        written.push(surface.display().to_string());
+        written.push(net.display().to_string());
+    }
+    Ok(format!("wrote {}", written.join(", ")))
+}
+
+/// The master surface of a pair, [`SUBDIVISIONS`]² quads per knot span (B-spline)
+/// or facet. Each span gets its own points, so the facets' normals stay per facet.
+pub fn master_surface_grid(p: &ContactPair, x: &[Vec3]) -> Result<vtk::Grid, StageRunError> {
+    let bad = |e: crate::spline::SplineError| StageRunError::Usage(format!("pair '{}': {e}", p.name));
+    let (a, b) = (p.net.a, p.net.b);
+    enum Master {
+        Bspline(BSplinePatch),
+        Facet(FacetSurface),
+    }
+    let master = match p.master_kind {
+        MasterKind::Bspline => {
+            let patch = BSplinePatch::new(a, b, p.orders[0], p.orders[1]).map_err(bad)?;
+            patch.check_control_net(x).map_err(bad)?;
+            Master::Bspline(patch)
+        }
+        MasterKind::Facet => {
+            let f = FacetSurface::new(a, b).map_err(bad)?;
+            f.check_control_net(x).map_err(bad)?;
+            Master::Facet(f)
+        }
+    };
+    let spans = match &master {
+        Master::Bspline(patch) => patch.n_spans(),
+        Master::Facet(f) => f.n_cells(),
+    };
+    let eval = |cell: [usize; 2], xi: [f64; 2]| match &master {
+        Master::Bspline(patch) => patch.evaluate(x, xi),
+        Master::Facet(f) => {
+            let mut out = SurfacePoint::default();
+            f.evaluate_in_cell_into(x, cell, xi, &mut out);
+            out
+        }
+    };
+    let s = SUBDIVISIONS;
+    let mut g = vtk::Grid::default();
+    let (mut normal, mut xis) = (Vec::new(), Vec::new());
+    for sj in 0..spans[1] {
+        for si in 0..spans[0] {
+            let base = g.points.len() as u32;
+            for v in 0..=s {
+                for u in 0..=s {
+                    let xi = [(si as f64 + u as f64 / s as f64) / spans[0] as f64, (sj as f64 + v as f64 / s as f64) / spans[1] as f64];
+                    let sp = eval([si, sj], xi);
+                    g.points.push([sp.x_bar.x, sp.x_bar.y, sp.x_bar.z]);
+                    normal.extend([sp.n_bar.x, sp.n_bar.y, sp.n_bar.z]);
+                    xis.extend([xi[0], xi[1], 0.0]);
+                }
+            }
+            let id = |u: usize, v: usize| base + (u + (s + 1) * v) as u32;
+            for v in 0..s {
+                for u in 0..s {
+                    g.push_cell(vtk::CellKind::Quad, &[id(u, v), id(u + 1, v), id(u + 1, v + 1), id(u, v + 1)]);
+                }
+            }
+        }
+    }
+    g.point_data.push(vtk::Field::vector_f64("normal", normal));
+    g.point_data.push(vtk::Field::vector_f64("xi", xis));
+    Ok(g)
+}
+
+/// The control net as VTK lines: rows (along ξ¹) and columns (along ξ²) through the
+/// net's nodes (the current coordinates `x`, in net order); point data
+/// `gmsh_node_tag` and the grid position `i`, `j`.
+pub fn control_net_grid(p: &ContactPair, x: &[Vec3], mesh: &crate::mesh::Mesh) -> vtk::Grid {
+    let (a, b) = (p.net.a, p.net.b);
+    let mut g = vtk::Grid { points: x.iter().map(|v| [v.x, v.y, v.z]).collect(), ..Default::default() };
+    let id = |i: usize, j: usize| (i + a * j) as u32;
+    for j in 0..b {
+        for i in 0..a - 1 {
+            g.push_cell(vtk::CellKind::Line, &[id(i, j), id(i + 1, j)]);
+        }
+    }
+    for i in 0..a {
+        for j in 0..b - 1 {
+            g.push_cell(vtk::CellKind::Line, &[id(i, j), id(i, j + 1)]);
+        }
+    }
+    g.point_data.push(vtk::Field {
+        name: "gmsh_node_tag".into(),
+        components: 1,
+        values: vtk::FieldValues::I64(p.net.nodes.iter().map(|&n| mesh.node_tags[n as usize] as i64).collect()),
+    });
+    g.point_data.push(vtk::Field { name: "i".into(), components: 1, values: vtk::FieldValues::I32((0..a * b).map(|k| (k % a) as i32).collect()) });
+    g.point_data.push(vtk::Field { name: "j".into(), components: 1, values: vtk::FieldValues::I32((0..a * b).map(|k| (k / a) as i32).collect()) });
+    g
 }
 
 fn push_stress_fields(fields: &mut Vec<vtk::Field>, s: &[stresses::Tensor9]) {

@@ -6,6 +6,7 @@ pub mod export;
 pub mod gmsh;
 pub mod import;
 pub mod solve;
+pub mod tag;
 
 use crate::format::msh::MshError;
 use crate::format::setup::SetupError;
@@ -14,6 +15,7 @@ use crate::solver::newton::SetupFailure;
 use crate::solver::problem::ProblemError;
 use crate::format::stage::StageError;
 use crate::format::vtk::VtkError;
+use tag::TagError;
 
 /// Exit codes shared by every binary (ripgrep style): 0 success, 1 an I/O or
 /// environment failure, 2 bad input (file, mesh, setup), 3 a solve that did not
@@ -42,6 +44,8 @@ pub enum StageRunError {
     SolverSetup(#[from] SetupFailure),
     #[error(transparent)]
     Solve(#[from] SolveError),
+    #[error(transparent)]
+    Tag(#[from] TagError),
     #[error("{0}")]
     Usage(String),
     #[error("{0}")]

@@ -1,0 +1,252 @@
+//! The contact-model stage file, `.sccontact` (format `sccontact`, version 1.0),
+//! written by `sc-tag`: the mesh and, per contact pair, the slave nodes and the
+//! master surface as an ordered control net with its knot vectors (paper sec. 5).
+//!
+//! Records (container: [`super::stage`]):
+//! ```text
+//! META  pairs (YAML): per pair name, slave kind + set, master set, master kind,
+//!       orders [ka, kb], net [a, b]
+//! META  mesh metadata (as in .scmesh)
+//! mesh/…                 the mesh records (as in .scmesh, prefixed)
+//! pair/<p>/slave_nodes   u32 [n]      slave node indices, sorted
+//! pair/<p>/net           u32 [b, a]   control net node indices, row j holds i = 0..a
+//! pair/<p>/knots_1       f64 [a + ka] open uniform knot vector along ξ¹ (eq. 5.1)
+//! pair/<p>/knots_2       f64 [b + kb] along ξ²
+//! ```
+//! `<p>` is the pair's position in the META list (0, 1, …), so pair names need no
+//! escaping.
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use super::scmesh;
+use super::stage::{write_atomic, StageError, StageFile, StageWriter};
+use crate::contact::ControlNet;
+use crate::mesh::Mesh;
+use crate::spline::{KnotVector, SplineError};
+
+pub const FORMAT: &str = "sccontact";
+pub const MAJOR: u32 = 1;
+pub const MINOR: u32 = 0;
+
+/// How the master surface is represented.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum MasterKind {
+    /// One B-spline patch whose control points are the master nodes (the paper's method).
+    #[default]
+    Bspline,
+    /// Bilinear 4-node facets on the same net (the classic baseline; orders [2, 2]).
+    Facet,
+}
+
+impl MasterKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Bspline => "bspline",
+            Self::Facet => "facet",
+        }
+    }
+}
+
+/// What kind of set the slave was given as.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SlaveKind {
+    NodeSet,
+    /// A face set, used through its nodes.
+    FaceSet,
+}
+
+/// One contact pair: slave nodes against a master control net.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ContactPair {
+    pub name: String,
+    pub slave_kind: SlaveKind,
+    /// Name of the slave set.
+    pub slave: String,
+    /// Name of the master face set.
+    pub master: String,
+    pub master_kind: MasterKind,
+    /// B-spline orders [ka, kb] (order = degree + 1; [2, 2] for facets).
+    pub orders: [usize; 2],
+    /// Slave node indices, sorted and unique.
+    pub slave_nodes: Vec<u32>,
+    pub net: ControlNet,
+}
+
+impl ContactPair {
+    /// The open uniform knot vectors (eq. 5.1) along ξ¹ and ξ²; fails when an order
+    /// does not fit the net ("a 3-node row cannot carry order 4").
+    pub fn knot_vectors(&self) -> Result<[KnotVector; 2], SplineError> {
+        Ok([KnotVector::open_uniform(self.net.a, self.orders[0])?, KnotVector::open_uniform(self.net.b, self.orders[1])?])
+    }
+}
+
+#[derive(Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PairMeta {
+    name: String,
+    slave_kind: SlaveKind,
+    slave: String,
+    master: String,
+    master_kind: MasterKind,
+    orders: [usize; 2],
+    net: [usize; 2],
+}
+
+#[derive(Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PairsMeta {
+    source: String,
+    pairs: Vec<PairMeta>,
+}
+
+/// A contact model in memory.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ContactModel {
+    pub mesh: Mesh,
+    /// Where the mesh came from (the .scmesh path given to sc-tag).
+    pub source: String,
+    pub pairs: Vec<ContactPair>,
+}
+
+impl ContactModel {
+    /// Encode; fails only if a pair's orders do not fit its net (build pairs through
+    /// `stages::tag`, which checks that first).
+    pub fn encode(&self) -> Result<Vec<u8>, SplineError> {
+        let mut w = StageWriter::new(FORMAT, MAJOR, MINOR);
+        let meta = PairsMeta {
+            source: self.source.clone(),
+            pairs: self
+                .pairs
+                .iter()
+                .map(|p| PairMeta {
+                    name: p.name.clone(),
+                    slave_kind: p.slave_kind,
+                    slave: p.slave.clone(),
+                    master: p.master.clone(),
+                    master_kind: p.master_kind,
+                    orders: p.orders,
+                    net: [p.net.a, p.net.b],
+                })
+                .collect(),
+        };
+        w.meta(&serde_yaml::to_string(&meta).expect("pairs metadata serialises"));
+        w.meta(&scmesh::mesh_meta_yaml(&self.mesh, &self.source));
+        scmesh::write_mesh_records(&mut w, &self.mesh, "mesh/");
+        for (k, p) in self.pairs.iter().enumerate() {
+            let [k1, k2] = p.knot_vectors()?;
+            w.u32s(&format!("pair/{k}/slave_nodes"), &[p.slave_nodes.len() as u64], &p.slave_nodes);
+            w.u32s(&format!("pair/{k}/net"), &[p.net.b as u64, p.net.a as u64], &p.net.nodes);
+            w.f64s(&format!("pair/{k}/knots_1"), &[k1.knots().len() as u64], k1.knots());
+            w.f64s(&format!("pair/{k}/knots_2"), &[k2.knots().len() as u64], k2.knots());
+        }
+        Ok(w.finish())
+    }
+
+    /// Write atomically (`-` for standard output).
+    pub fn write(&self, path: &Path) -> Result<(), StageError> {
+        let bytes = self.encode().map_err(|e| StageError::Invalid { path: path.display().to_string(), name: "pair".into(), what: e.to_string() })?;
+        write_atomic(path, &bytes)
+    }
+
+    /// Decode and check: node indices in range, net size = a·b, orders fit the net,
+    /// knot vectors are the open uniform ones.
+    pub fn from_stage(f: &StageFile) -> Result<Self, StageError> {
+        let meta: PairsMeta = f.meta_as()?;
+        let mesh_meta = f.meta.get(1).ok_or_else(|| f.invalid("META", "the mesh metadata record is missing"))?;
+        let mesh = scmesh::read_mesh_records(f, "mesh/", mesh_meta)?;
+        let n = mesh.nodes.len();
+        let mut pairs = Vec::with_capacity(meta.pairs.len());
+        for (k, pm) in meta.pairs.into_iter().enumerate() {
+            let rec = |s: &str| format!("pair/{k}/{s}");
+            let slave_nodes = f.u32s(&rec("slave_nodes"), None)?.to_vec();
+            if slave_nodes.iter().any(|&v| v as usize >= n) {
+                return Err(f.invalid(&rec("slave_nodes"), format!("pair '{}' refers to a node beyond {n}", pm.name)));
+            }
+            let [a, b] = pm.net;
+            let nodes = f.u32s(&rec("net"), Some(a as u64))?.to_vec();
+            if nodes.len() != a * b {
+                return Err(f.invalid(&rec("net"), format!("pair '{}': metadata says a {a} × {b} net, the array holds {} ids", pm.name, nodes.len())));
+            }
+            if nodes.iter().any(|&v| v as usize >= n) {
+                return Err(f.invalid(&rec("net"), format!("pair '{}' refers to a node beyond {n}", pm.name)));
+            }
+            let pair = ContactPair {
+                name: pm.name,
+                slave_kind: pm.slave_kind,
+                slave: pm.slave,
+                master: pm.master,
+                master_kind: pm.master_kind,
+                orders: pm.orders,
+                slave_nodes,
+                net: ControlNet { a, b, nodes },
+            };
+            let kv = pair.knot_vectors().map_err(|e| f.invalid(&rec("net"), format!("pair '{}': {e}", pair.name)))?;
+            for (d, kv) in kv.iter().enumerate() {
+                let name = rec(&format!("knots_{}", d + 1));
+                if f.f64s(&name, None)? != kv.knots() {
+                    return Err(f.invalid(&name, format!("pair '{}': not the open uniform knot vector for {} points of order {}", pair.name, kv.n(), kv.order())));
+                }
+            }
+            pairs.push(pair);
+        }
+        Ok(Self { mesh, source: meta.source, pairs })
+    }
+
+    pub fn read(path: &Path) -> Result<Self, StageError> {
+        Self::from_stage(&StageFile::read(path, Some((FORMAT, MAJOR)))?)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::{Body, FaceSet, HexFace};
+
+    fn model() -> ContactModel {
+        let nodes: Vec<[f64; 3]> = (0..12).map(|k| [(k % 3) as f64, ((k / 3) % 2) as f64, (k / 6) as f64]).collect();
+        let id = |i: u32, j: u32, k: u32| i + 3 * j + 6 * k;
+        let hex = |i: u32| [id(i, 0, 0), id(i + 1, 0, 0), id(i + 1, 1, 0), id(i, 1, 0), id(i, 0, 1), id(i + 1, 0, 1), id(i + 1, 1, 1), id(i, 1, 1)];
+        let mesh = Mesh {
+            nodes,
+            hexes: vec![hex(0), hex(1)],
+            hex_body: vec![0, 0],
+            bodies: vec![Body { name: "b".into(), physical_tag: 1 }],
+            node_sets: vec![],
+            face_sets: vec![FaceSet { name: "top".into(), physical_tag: 2, faces: vec![HexFace { element: 0, local: 1 }, HexFace { element: 1, local: 1 }], quad_tags: vec![5, 6] }],
+            node_tags: (1..=12).collect(),
+            element_tags: vec![1, 2],
+        };
+        let net = crate::contact::control_net(&mesh, "top").unwrap();
+        let pair = ContactPair {
+            name: "p".into(),
+            slave_kind: SlaveKind::NodeSet,
+            slave: "s".into(),
+            master: "top".into(),
+            master_kind: MasterKind::Bspline,
+            orders: [3, 2],
+            slave_nodes: vec![0, 1],
+            net,
+        };
+        ContactModel { mesh, source: "m.scmesh".into(), pairs: vec![pair] }
+    }
+
+    #[test]
+    fn round_trip() {
+        let m = model();
+        let bytes = m.encode().unwrap();
+        let f = StageFile::parse("c.sccontact", &bytes, Some((FORMAT, MAJOR))).unwrap();
+        assert_eq!(ContactModel::from_stage(&f).unwrap(), m);
+    }
+
+    #[test]
+    fn order_too_high_is_refused_on_encode() {
+        let mut m = model();
+        m.pairs[0].orders = [4, 2];
+        let e = m.encode().unwrap_err().to_string();
+        assert!(e.contains("a 3-node row cannot carry order 4"), "{e}");
+    }
+}
