@@ -51,6 +51,7 @@ struct Args {
     quiet: bool,
 }
 
+#[allow(clippy::result_large_err)] // cold path; the error carries its culprit
 fn specs(args: &Args) -> Result<Vec<PairSpec>, tag::TagError> {
     let mut out = Vec::new();
     if let Some(f) = &args.pairs_file {

@@ -23,6 +23,10 @@
 //! | g_N, t_N, λ_N, ε_N | `g_n`, `t_n`, `lambda_n`, `eps_n` | 4.2–4.3 |
 //! | ξ̄^α, ā_α, ā_αβ, b̄_αβ | `xi`, `a_alpha`, `a_ab`, `b_ab` | 4.10–4.13 |
 
+// Errors carry their culprit (file and line, element, set name, the failing Newton
+// state) and travel only on cold paths: their size is deliberate, not boxed.
+#![allow(clippy::result_large_err)]
+
 pub mod assembly;
 pub mod contact;
 pub mod fem;

@@ -475,7 +475,7 @@ impl StageFile {
             writeln!(out, "    shape: {:?}", a.dims)?;
             writeln!(out, "    data:")?;
             let cols = if a.dims.len() >= 2 { a.dims[1..].iter().product::<u64>() as usize } else { 1 };
-            let rows = if cols == 0 { 0 } else { a.data.len() / cols };
+            let rows = a.data.len().checked_div(cols).unwrap_or(0);
             for r in 0..rows {
                 let range = r * cols..(r + 1) * cols;
                 let row: Vec<String> = match &a.data {

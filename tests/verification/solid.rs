@@ -266,8 +266,8 @@ fn hydrostatic_follower_pressure() {
     let stretch = (0.5 * (a + b)).cbrt();
     let inc = r.increments.last().unwrap();
     for (n, x) in mesh.nodes.iter().enumerate() {
-        for i in 0..3 {
-            let expect = (stretch - 1.0) * x[i];
+        for (i, xi) in x.iter().enumerate() {
+            let expect = (stretch - 1.0) * xi;
             assert!((inc.u[n][i] - expect).abs() < 1e-9, "node {n} comp {i}: {} vs {expect}", inc.u[n][i]);
         }
     }
