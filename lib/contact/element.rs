@@ -140,3 +140,195 @@ pub fn normal_contact(
     k.ger(eps_n * area, &nv, &nv, 1.0);
     ContactState { g_n: g, t_n: t, active: true }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fem::fd::{fd_jacobian, rel_err, FdStep};
+    use crate::spline::Mat2;
+
+    /// Cylindrical (radius 4 about the ξ²-parallel axis), wavy control net with unit
+    /// control-point spacing: curvature in both directions and a non-orthogonal
+    /// parametrisation (the rows are sheared).
+    fn curved_net(na: usize, nb: usize) -> Vec<Vec3> {
+        let rad = 4.0;
+        let mut x = Vec::with_capacity(na * nb);
+        for j in 0..nb {
+            for i in 0..na {
+                let th = (i as f64 + 0.2 * j as f64) / rad;
+                let y = j as f64 + 0.15 * (i as f64 * 0.9).sin();
+                let w = 0.12 * (0.8 * y).sin();
+                x.push(Vec3::new((rad + w) * th.sin(), y, (rad + w) * th.cos() - rad));
+            }
+        }
+        x
+    }
+
+    /// Closest point near `xi0` by Newton on f_α = (x_s − x̄)·ā_α = 0,
+    /// ∂f_α/∂ξ^β = −ā_αβ + (x_s − x̄)·ā_{α,β}; converged to round-off.
+    fn reproject(surf: &MasterSurface, x_all: &[Vec3], xs: &Vec3, xi0: [f64; 2]) -> [f64; 2] {
+        let mut xi = xi0;
+        for _ in 0..50 {
+            let (sp, _) = surf.evaluate_local(x_all, xi);
+            let d = xs - sp.x_bar;
+            let f = nalgebra::Vector2::new(d.dot(&sp.a_alpha[0]), d.dot(&sp.a_alpha[1]));
+            let jac = Mat2::from_fn(|a, b| -sp.a_ab[(a, b)] + d.dot(&sp.a_alpha_beta[a][b]));
+            let step = -jac.try_inverse().unwrap() * f;
+            xi[0] += step[0];
+            xi[1] += step[1];
+            if step.norm() < 1e-17 {
+                break;
+            }
+        }
+        xi
+    }
+
+    struct Case {
+        name: String,
+        surf_kind: (usize, usize, usize), // (na, nb, order); order 0 = facet
+        xi0: [f64; 2],
+    }
+
+    /// Runs one geometry with the laws (λ_N, ε_N) below and returns the worst FD error.
+    fn check_case(case: &Case) -> f64 {
+        let (na, nb, order) = case.surf_kind;
+        let patch;
+        let facet;
+        let surf = if order == 0 {
+            facet = FacetSurface::new(na, nb).unwrap();
+            MasterSurface::Facet(&facet)
+        } else {
+            patch = BSplinePatch::new(na, nb, order, order).unwrap();
+            MasterSurface::BSpline(&patch)
+        };
+        let x_all = curved_net(na, nb);
+        let size = 1.0; // control point spacing = element size
+        let (sp0, xm0) = surf.evaluate_local(&x_all, case.xi0);
+        let nodes: Vec<usize> = sp0.basis.nodes().to_vec();
+        let nc = nodes.len();
+        let m = 3 * (1 + nc);
+        let g0 = -1e-2 * size;
+        let xs0 = sp0.x_bar + sp0.n_bar * g0;
+        let area = 0.7;
+        let mut worst: f64 = 0.0;
+        // (λ_N, ε_N): pure penalty, augmented, and fixed multiplier (ε = 0: K is the
+        // geometric part t_N A_s ∂²g_N alone, so the curvature terms are tested bare)
+        for (lambda, eps) in [(0.0, 1e3), (-2.0, 50.0), (-1.0, 0.0)] {
+            let (mut r, mut k) = (DVector::zeros(0), DMatrix::zeros(0, 0));
+            let st = normal_contact(&xs0, &xm0, &sp0, lambda, eps, area, &mut r, &mut k);
+            assert!(st.active && (st.g_n - g0).abs() < 1e-14, "{}: {st:?}", case.name);
+            assert!((st.t_n - (lambda + eps * g0)).abs() < 1e-12);
+            // action = reaction: Σ_nodes f = 0; moment about the origin Σ x × f = t A g n̄ × n̄ = 0
+            let mut f = Vec3::zeros();
+            let mut mom = Vec3::zeros();
+            for a in 0..=nc {
+                let fa = Vec3::new(r[3 * a], r[3 * a + 1], r[3 * a + 2]);
+                let xa = if a == 0 { xs0 } else { xm0[a - 1] };
+                f += fa;
+                mom += xa.cross(&fa);
+            }
+            let scale = (st.t_n * area).abs();
+            assert!(f.norm() < 1e-12 * scale, "{}: force sum {f:?}", case.name);
+            assert!(mom.norm() < 1e-10 * scale * 10.0, "{}: moment {mom:?}", case.name);
+            assert!((&k - k.transpose()).norm() < 1e-10 * k.norm(), "{}: K not symmetric", case.name);
+            // u = [x_s; x_A]
+            let mut u = vec![0.0; m];
+            for c in 0..3 {
+                u[c] = xs0[c];
+                for a in 0..nc {
+                    u[3 * (1 + a) + c] = xm0[a][c];
+                }
+            }
+            // Central differences with h = 1e-7 × max(|u_j|, size): truncation
+            // ~h²|r'''| ≈ 1e-14 |K|, round-off ~ε_mach|r|/h ≈ 1e-9 |r|, projection
+            // round-off ~1e-16 in ξ̄ → 1e-9 — all ≪ 1e-6 relative to K (≥ |t_N|A_s κ).
+            let fd = fd_jacobian(
+                |v, out| {
+                    let mut x = x_all.clone();
+                    for (a, &nd) in nodes.iter().enumerate() {
+                        x[nd] = Vec3::new(v[3 * (1 + a)], v[3 * (1 + a) + 1], v[3 * (1 + a) + 2]);
+                    }
+                    let xs = Vec3::new(v[0], v[1], v[2]);
+                    let xi = reproject(&surf, &x, &xs, case.xi0);
+                    let (sp, xm) = surf.evaluate_local(&x, xi);
+                    assert_eq!(sp.basis.nodes(), &nodes[..], "perturbation left the span");
+                    let (mut rr, mut kk) = (DVector::zeros(0), DMatrix::zeros(0, 0));
+                    normal_contact(&xs, &xm, &sp, lambda, eps, area, &mut rr, &mut kk);
+                    out.copy_from_slice(rr.as_slice());
+                },
+                &u,
+                m,
+                FdStep { rel_step: 1e-7, scale: size },
+            );
+            let e = rel_err(k.as_slice(), fd.as_slice());
+            eprintln!("FD {} λ={lambda} ε={eps}: rel err {e:.2e} (|K|={:.3e})", case.name, k.norm());
+            assert!(e < 1e-6, "{} λ={lambda} ε={eps}: FD rel err {e:e}", case.name);
+            worst = worst.max(e);
+        }
+        worst
+    }
+
+    fn mid(s: usize, m: usize) -> f64 {
+        (s as f64 + 0.37) / m as f64
+    }
+
+    #[test]
+    fn tangent_matches_finite_differences() {
+        let (na, nb) = (7, 6);
+        let mut cases = Vec::new();
+        // facet: cells = spans of order 2 (na − 1 × nb − 1)
+        for (order, label) in [(0, "facet"), (2, "bspline k=2"), (3, "bspline k=3"), (4, "bspline k=4")] {
+            let k = order.max(2);
+            let (ma, mb) = (na - k + 1, nb - k + 1);
+            cases.push(Case {
+                name: format!("{label} interior"),
+                surf_kind: (na, nb, order),
+                xi0: [mid(ma / 2, ma), mid(mb / 2, mb)],
+            });
+            cases.push(Case {
+                name: format!("{label} edge span"),
+                surf_kind: (na, nb, order),
+                xi0: [mid(0, ma), mid(mb - 1, mb)],
+            });
+        }
+        for c in &cases {
+            check_case(c);
+        }
+    }
+
+    #[test]
+    fn inactive_gives_zero() {
+        let patch = BSplinePatch::new(6, 5, 3, 3).unwrap();
+        let surf = MasterSurface::BSpline(&patch);
+        let x = curved_net(6, 5);
+        let (sp, xm) = surf.evaluate_local(&x, [0.4, 0.6]);
+        let (mut r, mut k) = (DVector::from_element(3, 1.0), DMatrix::from_element(2, 2, 1.0));
+        // open gap, no multiplier
+        let st = normal_contact(&(sp.x_bar + sp.n_bar * 0.01), &xm, &sp, 0.0, 1e3, 1.0, &mut r, &mut k);
+        assert!(!st.active && st.t_n == 0.0 && (st.g_n - 0.01).abs() < 1e-14);
+        assert_eq!(r.len(), 3 * (1 + 9));
+        assert!(r.iter().all(|&v| v == 0.0) && k.iter().all(|&v| v == 0.0) && k.nrows() == 30);
+        // penetration but a tensile multiplier outweighs it (augmented Lagrangian release)
+        let st = normal_contact(&(sp.x_bar - sp.n_bar * 0.01), &xm, &sp, 20.0, 1e3, 1.0, &mut r, &mut k);
+        assert!(!st.active && r.iter().all(|&v| v == 0.0));
+        // compressive: slave pushed along +n̄ (force on it = −r_s)
+        let st = normal_contact(&(sp.x_bar - sp.n_bar * 0.01), &xm, &sp, 0.0, 1e3, 2.0, &mut r, &mut k);
+        assert!(st.active && (st.t_n + 10.0).abs() < 1e-9);
+        let f_s = -Vec3::new(r[0], r[1], r[2]);
+        assert!((f_s - sp.n_bar * 20.0).norm() < 1e-9);
+    }
+
+    /// The element's ξ̄ input agrees with the production projector on the patch.
+    #[test]
+    fn projector_gives_same_foot_point() {
+        let patch = BSplinePatch::new(7, 6, 3, 3).unwrap();
+        let x = curved_net(7, 6);
+        let surf = MasterSurface::BSpline(&patch);
+        let (sp, _) = surf.evaluate_local(&x, [0.43, 0.57]);
+        let xs = sp.x_bar - sp.n_bar * 0.01;
+        let proj = crate::spline::BSplineProjector::new(patch.clone(), &x).unwrap().project(&xs);
+        assert!(proj.converged);
+        assert!((proj.xi[0] - 0.43).abs() < 1e-10 && (proj.xi[1] - 0.57).abs() < 1e-10, "{:?}", proj.xi);
+        assert!((proj.g + 0.01).abs() < 1e-12);
+    }
+}
