@@ -105,6 +105,7 @@ pub fn normal_contact(
     let mut nv = DVector::zeros(m);
     let mut tv = [DVector::zeros(m), DVector::zeros(m)];
     let mut na = [DVector::zeros(m), DVector::zeros(m)];
+    #[allow(clippy::needless_range_loop)] // c: Cartesian index, a: basis index, al: α
     for c in 0..3 {
         nv[c] = n[c];
         for al in 0..2 {
@@ -263,6 +264,16 @@ mod tests {
             let e = rel_err(k.as_slice(), fd.as_slice());
             eprintln!("FD {} λ={lambda} ε={eps}: rel err {e:.2e} (|K|={:.3e})", case.name, k.norm());
             assert!(e < 1e-6, "{} λ={lambda} ε={eps}: FD rel err {e:e}", case.name);
+            if eps == 0.0 {
+                // the curvature terms matter: dropping b̄_αβ must break the FD match
+                let mut flat = sp0;
+                flat.b_ab = Mat2::zeros();
+                let (mut r2, mut k2) = (DVector::zeros(0), DMatrix::zeros(0, 0));
+                normal_contact(&xs0, &xm0, &flat, lambda, eps, area, &mut r2, &mut k2);
+                let e_flat = rel_err(k2.as_slice(), fd.as_slice());
+                eprintln!("   without b̄_αβ terms: rel err {e_flat:.2e}");
+                assert!(e_flat > 1e-3, "{}: curvature terms too small to be tested ({e_flat:e})", case.name);
+            }
             worst = worst.max(e);
         }
         worst
