@@ -349,14 +349,7 @@ mod tests {
     use crate::assembly::dofs::DofMap;
     use crate::assembly::pattern::{structured_hex_grid, NodeGroups};
 
-    /// Deterministic LCG (Knuth MMIX constants), values in [-1, 1).
-    struct Lcg(u64);
-    impl Lcg {
-        fn next(&mut self) -> f64 {
-            self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            ((self.0 >> 11) as f64) / ((1u64 << 53) as f64) * 2.0 - 1.0
-        }
-    }
+    use crate::fem::fd::Lcg;
 
     fn hex_contribution(e: usize, r: &mut HexVector, k: &mut HexMatrix) -> Result<(), String> {
         let mut rng = Lcg(0x9E37_79B9 ^ (e as u64).wrapping_mul(0x1234_5678_9ABC));

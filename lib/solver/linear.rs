@@ -492,14 +492,7 @@ mod tests {
     use super::*;
     use crate::solver::bench::{elastic_cube_system, relative_residual};
 
-    /// Deterministic LCG, values in [-1, 1).
-    struct Lcg(u64);
-    impl Lcg {
-        fn next(&mut self) -> f64 {
-            self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            ((self.0 >> 11) as f64) / ((1u64 << 53) as f64) * 2.0 - 1.0
-        }
-    }
+    use crate::fem::fd::Lcg;
 
     /// CSC (entries where `keep(i, j)`, rows sorted) of a dense matrix.
     fn dense_to_csc(a: &[Vec<f64>], keep: impl Fn(usize, usize) -> bool) -> (SymbolicSparseColMat<usize>, Vec<f64>) {
