@@ -354,10 +354,10 @@ mod tests {
     fn hex_contribution(e: usize, r: &mut HexVector, k: &mut HexMatrix) -> Result<(), String> {
         let mut rng = Lcg(0x9E37_79B9 ^ (e as u64).wrapping_mul(0x1234_5678_9ABC));
         for v in r.iter_mut() {
-            *v = rng.next();
+            *v = rng.uniform();
         }
         for v in k.iter_mut() {
-            *v = rng.next() * 1e3;
+            *v = rng.uniform() * 1e3;
         }
         Ok(())
     }
@@ -365,10 +365,10 @@ mod tests {
     fn group_contribution(g: usize, r: &mut DVector<f64>, k: &mut DMatrix<f64>) -> Result<(), String> {
         let mut rng = Lcg(77 + g as u64);
         for v in r.iter_mut() {
-            *v = rng.next();
+            *v = rng.uniform();
         }
         for v in k.iter_mut() {
-            *v = rng.next();
+            *v = rng.uniform();
         }
         Ok(())
     }

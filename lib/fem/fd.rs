@@ -85,6 +85,17 @@ pub fn rel_err_floor(a: &[f64], b: &[f64], floor: f64) -> f64 {
     }
 }
 
+/// Deterministic pseudo-random numbers for tests (64-bit LCG, Knuth MMIX
+/// constants), values in [-1, 1); no external crate, same sequence everywhere.
+pub struct Lcg(pub u64);
+
+impl Lcg {
+    pub fn uniform(&mut self) -> f64 {
+        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        ((self.0 >> 11) as f64) / ((1u64 << 53) as f64) * 2.0 - 1.0
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -106,16 +117,5 @@ mod tests {
         );
         let ex = DMatrix::from_row_slice(2, 3, &[x[1], x[0], 0.0, 0.0, 0.0, x[2].exp()]);
         assert!(rel_err(jac.as_slice(), ex.as_slice()) < 1e-9);
-    }
-}
-
-/// Deterministic pseudo-random numbers for tests (64-bit LCG, Knuth MMIX
-/// constants), values in [-1, 1); no external crate, same sequence everywhere.
-pub struct Lcg(pub u64);
-
-impl Lcg {
-    pub fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-        ((self.0 >> 11) as f64) / ((1u64 << 53) as f64) * 2.0 - 1.0
     }
 }

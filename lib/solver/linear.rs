@@ -558,17 +558,17 @@ mod tests {
             for j in 0..i {
                 let coupled = j < nk && ((i < nk && (i - j) <= 3) || (i >= nk && (i * 7 + j) % 5 == 0));
                 if coupled {
-                    let v = rng.next();
+                    let v = rng.uniform();
                     a[i][j] = v;
                     a[j][i] = v;
                 }
             }
         }
         for i in 0..nk {
-            a[i][i] = 8.0 + rng.next();
+            a[i][i] = 8.0 + rng.uniform();
         }
         for i in nk..n {
-            a[i][i] = -1e-3 * (1.5 + rng.next());
+            a[i][i] = -1e-3 * (1.5 + rng.uniform());
         }
         a
     }
@@ -601,9 +601,9 @@ mod tests {
         for (i, row) in a.iter_mut().enumerate() {
             for (j, v) in row.iter_mut().enumerate() {
                 if i == j {
-                    *v = 0.5 * rng.next(); // not diagonally dominant: pivoting needed
+                    *v = 0.5 * rng.uniform(); // not diagonally dominant: pivoting needed
                 } else if (i + 2 * j) % 7 == 0 || i.abs_diff(j) == 1 {
-                    *v = rng.next();
+                    *v = rng.uniform();
                 }
             }
         }
