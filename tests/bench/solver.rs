@@ -20,7 +20,7 @@ use std::time::Instant;
 use splinecontact::format::scmesh;
 use splinecontact::format::scres::{Results, RunStatus};
 use splinecontact::format::setup::SolveSetup;
-use splinecontact::mesh::{Body, Mesh, NodeSet};
+use splinecontact::mesh::Mesh;
 use splinecontact::solver::log::Verbosity;
 use splinecontact::stages::solve::solve;
 
@@ -29,46 +29,14 @@ const LENGTH: f64 = 10.0;
 const TIP_FORCE: f64 = 0.4;
 const DEFAULT_SIZES: &str = "40x4x4,100x10x10,200x22x22";
 
-/// An nx × ny × nz block of LENGTH × 1 × 1 at the origin: body "block", node sets
-/// "x0" (the clamped face) and "x1" (the loaded face). Same numbering as
-/// tests/common/grid.rs (x fastest).
+/// The structured block of the integration tests (`tests/common/grid.rs`): body
+/// "block", node sets "x0" (clamped) and "x1" (loaded) among the six faces.
+#[path = "../common/grid.rs"]
+#[allow(dead_code)]
+mod grid;
+
 fn cantilever(nx: usize, ny: usize, nz: usize) -> Mesh {
-    let id = |i: usize, j: usize, k: usize| (i + (nx + 1) * (j + (ny + 1) * k)) as u32;
-    let mut nodes = Vec::with_capacity((nx + 1) * (ny + 1) * (nz + 1));
-    for k in 0..=nz {
-        for j in 0..=ny {
-            for i in 0..=nx {
-                nodes.push([i as f64 * LENGTH / nx as f64, j as f64 / ny as f64, k as f64 / nz as f64]);
-            }
-        }
-    }
-    let mut hexes = Vec::with_capacity(nx * ny * nz);
-    for k in 0..nz {
-        for j in 0..ny {
-            for i in 0..nx {
-                hexes.push([id(i, j, k), id(i + 1, j, k), id(i + 1, j + 1, k), id(i, j + 1, k), id(i, j, k + 1), id(i + 1, j, k + 1), id(i + 1, j + 1, k + 1), id(i, j + 1, k + 1)]);
-            }
-        }
-    }
-    let face = |i: usize| -> Vec<u32> {
-        let mut v: Vec<u32> = (0..=nz).flat_map(|k| (0..=ny).map(move |j| id(i, j, k))).collect();
-        v.sort_unstable();
-        v
-    };
-    let m = hexes.len();
-    Mesh {
-        node_tags: (1..=nodes.len() as u64).collect(),
-        nodes,
-        hexes,
-        hex_body: vec![0; m],
-        bodies: vec![Body { name: "block".into(), physical_tag: 1 }],
-        node_sets: vec![
-            NodeSet { name: "x0".into(), physical_tag: 2, dim: 2, nodes: face(0) },
-            NodeSet { name: "x1".into(), physical_tag: 3, dim: 2, nodes: face(nx) },
-        ],
-        face_sets: Vec::new(),
-        element_tags: (1..=m as u64).collect(),
-    }
+    grid::block([nx, ny, nz], [LENGTH, 1.0, 1.0], 0.0)
 }
 
 fn setup_yaml() -> String {
