@@ -50,3 +50,10 @@ Physical Surface("lower_top") = {lower[0]};                    // master contact
 Physical Surface("upper_bottom") = {1011:1014};           // slave contact surface
 Physical Surface("upper_top") = {up[0], up[6], up[12], up[18]};
 Physical Point("load_node") = {load_pt[0]};
+// Supports that remove the upper block's rigid in-plane modes (frictionless contact
+// carries no tangential force): the two nodes on the vertical axis x = y = 0 are held
+// in x and y, the top node at (0, a) in x. By symmetry their reactions vanish.
+axis_pts[] = Point In BoundingBox {-0.1, -0.1, zb - 0.1, 0.1, 0.1, zb + h + 0.1};
+twist_pt[] = Point In BoundingBox {-0.1, a - 0.1, zb + h - 0.1, 0.1, a + 0.1, zb + h + 0.1};
+Physical Point("upper_axis") = {axis_pts[]};
+Physical Point("upper_twist") = {twist_pt[]};
