@@ -25,9 +25,12 @@
 //! `docs/theory.md`; the tests check `K` against central differences of `r` with the
 //! slave node re-projected at every perturbation.
 
-use nalgebra::{DMatrix, DVector};
+use nalgebra::{DMatrix, DVector, DVectorView};
 
-use crate::spline::{BSplinePatch, FacetSurface, SurfacePoint, Vec3};
+use crate::spline::{BSplinePatch, FacetSurface, SurfacePoint, Vec3, MAX_NODES};
+
+/// Largest element size `3(1 + n_c)`.
+const MAX_DOFS: usize = 3 * (1 + MAX_NODES);
 
 /// Outcome of one slave-node evaluation.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -38,6 +41,30 @@ pub struct ContactState {
     pub t_n: f64,
     /// Whether λ_N + ε_N g_N < 0 (the node carries force).
     pub active: bool,
+}
+
+/// The local contact problem has no unique solution.
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+pub enum ContactElementError {
+    /// ā_αβ − g_N b̄_αβ is singular: the slave node sits at a centre of curvature of
+    /// the master (so deep inside it that the closest point is not unique).
+    #[error("slave node at a centre of curvature of the master (g_N = {g_n:e}): the closest point is not unique")]
+    FocalPoint { g_n: f64 },
+}
+
+/// The contact law of one slave node (eq. 4.2).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NormalLaw {
+    /// Lagrange multiplier λ_N (≤ 0), fixed during a Newton solve.
+    pub lambda_n: f64,
+    /// Penalty ε_N.
+    pub eps_n: f64,
+    /// Tributary area A_s of the slave node (eq. 6.1).
+    pub area: f64,
+    /// A node that is not active but has λ_N + ε_N g_N ≤ ε_N·touch (touching within
+    /// `touch`, a length) contributes the closed-branch stiffness ε_N A_s N Nᵀ with no
+    /// force, so a body that starts touching is not free (see `docs/theory.md`).
+    pub touch: f64,
 }
 
 /// The master surface kind: the B-spline patch or the bilinear facets over the same net.
@@ -61,26 +88,27 @@ impl MasterSurface<'_> {
     }
 }
 
+/// The first `m` entries of a stack buffer as a vector view.
+fn view(v: &[f64; MAX_DOFS], m: usize) -> DVectorView<'_, f64> {
+    DVectorView::from_slice(&v[..m], m)
+}
+
 /// Residual `r` (length `3(1 + n_c)`) and consistent tangent `K = ∂r/∂u` of one
 /// slave node `xs` in frictionless contact with the master, penalty / augmented
 /// Lagrangian law `t_N = min(0, λ_N + ε_N g_N)` (see module docs for the sign
-/// convention). `xm` are the `n_c` control points of `sp.basis.nodes()` and `sp` is the
-/// surface point at the converged closest-point projection ξ̄ (built from `xm`);
-/// `area` is the slave node's tributary area A_s. `r` and `k` are resized if needed
-/// and overwritten; both are zero when the node is inactive.
-#[allow(clippy::too_many_arguments)]
+/// convention). `sp` is the surface point at the converged closest-point projection
+/// ξ̄ (its basis lists the `n_c` control points the element couples to). `r` and `k`
+/// are resized if needed and overwritten; both are zero when the node is open (and
+/// `k` holds only ε_N A_s N Nᵀ when it is touching, see [`NormalLaw::touch`]).
+/// No heap allocation when `r` and `k` already have the right size.
 pub fn normal_contact(
     xs: &Vec3,
-    xm: &[Vec3],
     sp: &SurfacePoint,
-    lambda_n: f64,
-    eps_n: f64,
-    area: f64,
+    law: &NormalLaw,
     r: &mut DVector<f64>,
     k: &mut DMatrix<f64>,
-) -> ContactState {
+) -> Result<ContactState, ContactElementError> {
     let nc = sp.basis.len();
-    assert_eq!(xm.len(), nc, "normal_contact: one master point per nonzero basis function");
     let m = 3 * (1 + nc);
     if r.len() != m {
         *r = DVector::zeros(m);
@@ -93,18 +121,18 @@ pub fn normal_contact(
         k.fill(0.0);
     }
     let n = sp.n_bar;
-    let g = (xs - sp.x_bar).dot(&n);
-    let trial = lambda_n + eps_n * g;
-    if trial >= 0.0 {
-        return ContactState { g_n: g, t_n: 0.0, active: false };
+    let g = (xs - sp.x_bar).dot(&n); // eq. 4.3
+    let trial = law.lambda_n + law.eps_n * g; // eq. 4.2
+    let touching = trial <= law.eps_n * law.touch;
+    if trial >= 0.0 && !touching {
+        return Ok(ContactState { g_n: g, t_n: 0.0, active: false });
     }
-    let t = trial;
     let q = sp.basis.q();
     let qa = sp.basis.q_alpha();
-    // N, T_α, N_α as full vectors (small: 3(1+n_c) ≤ 111)
-    let mut nv = DVector::zeros(m);
-    let mut tv = [DVector::zeros(m), DVector::zeros(m)];
-    let mut na = [DVector::zeros(m), DVector::zeros(m)];
+    // N = ∂g_N/∂u (eq. 6.2), T_α = [ā_α; −Q_A ā_α], N_α = [0; −Q_{A,α} n̄]; stack buffers
+    let mut nv = [0.0; MAX_DOFS];
+    let mut tv = [[0.0; MAX_DOFS]; 2];
+    let mut na = [[0.0; MAX_DOFS]; 2];
     #[allow(clippy::needless_range_loop)] // c: Cartesian index, a: basis index, al: α
     for c in 0..3 {
         nv[c] = n[c];
@@ -120,26 +148,39 @@ pub fn normal_contact(
             }
         }
     }
+    let a_s = law.area;
+    if trial >= 0.0 {
+        // touching, not pressed: closed-branch stiffness only
+        k.ger(law.eps_n * a_s, &view(&nv, m), &view(&nv, m), 1.0);
+        return Ok(ContactState { g_n: g, t_n: 0.0, active: false });
+    }
+    let t = trial;
     // Δξ̄^α = D^{αβ} (T_β − g N_β)·Δu,  D = (ā_αβ − g b̄_αβ)⁻¹
     let mm = sp.a_ab - sp.b_ab * g;
-    let d = mm.try_inverse().expect("normal_contact: singular ā_αβ − g b̄_αβ (slave at a focal point)");
-    let w = [&tv[0] - &na[0] * g, &tv[1] - &na[1] * g];
-    let dxi = [&w[0] * d[(0, 0)] + &w[1] * d[(0, 1)], &w[0] * d[(1, 0)] + &w[1] * d[(1, 1)]];
-    let ai = sp.a_inv;
-    let c = ai * sp.b_ab; // c[(α, β)] = ā^{αγ} b̄_γβ
-    // Hessian of g_N
-    let mut h = DMatrix::zeros(m, m);
-    for al in 0..2 {
-        h.ger(1.0, &na[al], &dxi[al], 1.0);
-        for be in 0..2 {
-            h.ger(ai[(al, be)], &tv[be], &na[al], 1.0);
-            h.ger(-c[(al, be)], &tv[al], &dxi[be], 1.0);
+    let d = mm.try_inverse().ok_or(ContactElementError::FocalPoint { g_n: g })?;
+    let mut dxi = [[0.0; MAX_DOFS]; 2];
+    for i in 0..m {
+        let w = [tv[0][i] - g * na[0][i], tv[1][i] - g * na[1][i]];
+        for al in 0..2 {
+            dxi[al][i] = d[(al, 0)] * w[0] + d[(al, 1)] * w[1];
         }
     }
-    r.copy_from(&(&nv * (t * area)));
-    k.copy_from(&(h * (t * area)));
-    k.ger(eps_n * area, &nv, &nv, 1.0);
-    ContactState { g_n: g, t_n: t, active: true }
+    let ai = sp.a_inv;
+    let c = ai * sp.b_ab; // c[(α, β)] = ā^{αγ} b̄_γβ
+    // K = t_N A_s ∂²g_N + ε_N A_s N Nᵀ (eq. 6.5), ∂²g_N as in the module docs
+    let ta = t * a_s;
+    for al in 0..2 {
+        k.ger(ta, &view(&na[al], m), &view(&dxi[al], m), 1.0);
+        for be in 0..2 {
+            k.ger(ta * ai[(al, be)], &view(&tv[be], m), &view(&na[al], m), 1.0);
+            k.ger(-ta * c[(al, be)], &view(&tv[al], m), &view(&dxi[be], m), 1.0);
+        }
+    }
+    k.ger(law.eps_n * a_s, &view(&nv, m), &view(&nv, m), 1.0);
+    for i in 0..m {
+        r[i] = ta * nv[i]; // eq. 6.2: r = t_N A_s N
+    }
+    Ok(ContactState { g_n: g, t_n: t, active: true })
 }
 
 #[cfg(test)]
@@ -216,7 +257,7 @@ mod tests {
         // geometric part t_N A_s ∂²g_N alone, so the curvature terms are tested bare)
         for (lambda, eps) in [(0.0, 1e3), (-2.0, 50.0), (-1.0, 0.0)] {
             let (mut r, mut k) = (DVector::zeros(0), DMatrix::zeros(0, 0));
-            let st = normal_contact(&xs0, &xm0, &sp0, lambda, eps, area, &mut r, &mut k);
+            let st = normal_contact(&xs0, &sp0, &NormalLaw { lambda_n: lambda, eps_n: eps, area, touch: 0.0 }, &mut r, &mut k).unwrap();
             assert!(st.active && (st.g_n - g0).abs() < 1e-14, "{}: {st:?}", case.name);
             assert!((st.t_n - (lambda + eps * g0)).abs() < 1e-12);
             // action = reaction: Σ_nodes f = 0; moment about the origin Σ x × f = t A g n̄ × n̄ = 0
@@ -251,10 +292,10 @@ mod tests {
                     }
                     let xs = Vec3::new(v[0], v[1], v[2]);
                     let xi = reproject(&surf, &x, &xs, case.xi0);
-                    let (sp, xm) = surf.evaluate_local(&x, xi);
+                    let (sp, _xm) = surf.evaluate_local(&x, xi);
                     assert_eq!(sp.basis.nodes(), &nodes[..], "perturbation left the span");
                     let (mut rr, mut kk) = (DVector::zeros(0), DMatrix::zeros(0, 0));
-                    normal_contact(&xs, &xm, &sp, lambda, eps, area, &mut rr, &mut kk);
+                    normal_contact(&xs, &sp, &NormalLaw { lambda_n: lambda, eps_n: eps, area, touch: 0.0 }, &mut rr, &mut kk).unwrap();
                     out.copy_from_slice(rr.as_slice());
                 },
                 &u,
@@ -269,7 +310,7 @@ mod tests {
                 let mut flat = sp0;
                 flat.b_ab = Mat2::zeros();
                 let (mut r2, mut k2) = (DVector::zeros(0), DMatrix::zeros(0, 0));
-                normal_contact(&xs0, &xm0, &flat, lambda, eps, area, &mut r2, &mut k2);
+                normal_contact(&xs0, &flat, &NormalLaw { lambda_n: lambda, eps_n: eps, area, touch: 0.0 }, &mut r2, &mut k2).unwrap();
                 let e_flat = rel_err(k2.as_slice(), fd.as_slice());
                 eprintln!("   without b̄_αβ terms: rel err {e_flat:.2e}");
                 assert!(e_flat > 1e-3, "{}: curvature terms too small to be tested ({e_flat:e})", case.name);
@@ -312,18 +353,18 @@ mod tests {
         let patch = BSplinePatch::new(6, 5, 3, 3).unwrap();
         let surf = MasterSurface::BSpline(&patch);
         let x = curved_net(6, 5);
-        let (sp, xm) = surf.evaluate_local(&x, [0.4, 0.6]);
+        let (sp, _) = surf.evaluate_local(&x, [0.4, 0.6]);
         let (mut r, mut k) = (DVector::from_element(3, 1.0), DMatrix::from_element(2, 2, 1.0));
         // open gap, no multiplier
-        let st = normal_contact(&(sp.x_bar + sp.n_bar * 0.01), &xm, &sp, 0.0, 1e3, 1.0, &mut r, &mut k);
+        let st = normal_contact(&(sp.x_bar + sp.n_bar * 0.01), &sp, &NormalLaw { lambda_n: 0.0, eps_n: 1e3, area: 1.0, touch: 0.0 }, &mut r, &mut k).unwrap();
         assert!(!st.active && st.t_n == 0.0 && (st.g_n - 0.01).abs() < 1e-14);
         assert_eq!(r.len(), 3 * (1 + 9));
         assert!(r.iter().all(|&v| v == 0.0) && k.iter().all(|&v| v == 0.0) && k.nrows() == 30);
         // penetration but a tensile multiplier outweighs it (augmented Lagrangian release)
-        let st = normal_contact(&(sp.x_bar - sp.n_bar * 0.01), &xm, &sp, 20.0, 1e3, 1.0, &mut r, &mut k);
+        let st = normal_contact(&(sp.x_bar - sp.n_bar * 0.01), &sp, &NormalLaw { lambda_n: 20.0, eps_n: 1e3, area: 1.0, touch: 0.0 }, &mut r, &mut k).unwrap();
         assert!(!st.active && r.iter().all(|&v| v == 0.0));
         // compressive: slave pushed along +n̄ (force on it = −r_s)
-        let st = normal_contact(&(sp.x_bar - sp.n_bar * 0.01), &xm, &sp, 0.0, 1e3, 2.0, &mut r, &mut k);
+        let st = normal_contact(&(sp.x_bar - sp.n_bar * 0.01), &sp, &NormalLaw { lambda_n: 0.0, eps_n: 1e3, area: 2.0, touch: 0.0 }, &mut r, &mut k).unwrap();
         assert!(st.active && (st.t_n + 10.0).abs() < 1e-9);
         let f_s = -Vec3::new(r[0], r[1], r[2]);
         assert!((f_s - sp.n_bar * 20.0).norm() < 1e-9);

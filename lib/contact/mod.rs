@@ -1,11 +1,16 @@
-//! Contact definitions: which surfaces meet, and the master surface as the
-//! B-spline control net of paper sec. 5.
+//! Contact: which surfaces meet, the master surface as the B-spline control net of
+//! paper sec. 5, and the node-to-surface contact element of secs. 4 and 6.
 //!
-//! | file    | concept |
-//! |---------|---------|
-//! | [`net`] | a master face set ordered into the a × b control net P_{i,j} (eq. 5.2), outward n̄ |
+//! | file          | concept |
+//! |---------------|---------|
+//! | [`net`]       | a master face set ordered into the a × b control net P_{i,j} (eq. 5.2), outward n̄ |
+//! | [`tributary`] | slave tributary areas A_s (eq. 6.1) |
+//! | [`element`]   | one slave node against the master: g_N, t_N, residual and tangent (eqs. 4.2–4.3, 6.2–6.5) |
+//! | [`pair`]      | one pair during the solve: search, active set, Uzawa updates |
 
 pub mod element;
 pub mod net;
+pub mod pair;
+pub mod tributary;
 
 pub use net::{control_net, ControlNet, NetError};

@@ -84,9 +84,10 @@ impl ContactPair {
     }
 }
 
-#[derive(Debug, Serialize, Deserialize)]
+/// A pair's metadata as stored in META (also in `.scres`, which carries the pairs).
+#[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct PairMeta {
+pub(crate) struct PairMeta {
     name: String,
     slave_kind: SlaveKind,
     slave: String,
@@ -101,6 +102,65 @@ struct PairMeta {
 struct PairsMeta {
     source: String,
     pairs: Vec<PairMeta>,
+}
+
+pub(crate) fn pair_meta(p: &ContactPair) -> PairMeta {
+    PairMeta {
+        name: p.name.clone(),
+        slave_kind: p.slave_kind,
+        slave: p.slave.clone(),
+        master: p.master.clone(),
+        master_kind: p.master_kind,
+        orders: p.orders,
+        net: [p.net.a, p.net.b],
+    }
+}
+
+/// The arrays of pair `k`: `pair/<k>/slave_nodes|net|knots_1|knots_2`.
+pub(crate) fn write_pair_records(w: &mut StageWriter, k: usize, p: &ContactPair) -> Result<(), SplineError> {
+    let [k1, k2] = p.knot_vectors()?;
+    w.u32s(&format!("pair/{k}/slave_nodes"), &[p.slave_nodes.len() as u64], &p.slave_nodes);
+    w.u32s(&format!("pair/{k}/net"), &[p.net.b as u64, p.net.a as u64], &p.net.nodes);
+    w.f64s(&format!("pair/{k}/knots_1"), &[k1.knots().len() as u64], k1.knots());
+    w.f64s(&format!("pair/{k}/knots_2"), &[k2.knots().len() as u64], k2.knots());
+    Ok(())
+}
+
+/// Pair `k` from its META entry and arrays, checked against a mesh of `n` nodes:
+/// node indices in range, net size = a·b, orders fit the net, knot vectors are the
+/// open uniform ones.
+pub(crate) fn read_pair(f: &StageFile, k: usize, pm: PairMeta, n: usize) -> Result<ContactPair, StageError> {
+    let rec = |s: &str| format!("pair/{k}/{s}");
+    let slave_nodes = f.u32s(&rec("slave_nodes"), None)?.to_vec();
+    if slave_nodes.iter().any(|&v| v as usize >= n) {
+        return Err(f.invalid(&rec("slave_nodes"), format!("pair '{}' refers to a node beyond {n}", pm.name)));
+    }
+    let [a, b] = pm.net;
+    let nodes = f.u32s(&rec("net"), Some(a as u64))?.to_vec();
+    if nodes.len() != a * b {
+        return Err(f.invalid(&rec("net"), format!("pair '{}': metadata says a {a} × {b} net, the array holds {} ids", pm.name, nodes.len())));
+    }
+    if nodes.iter().any(|&v| v as usize >= n) {
+        return Err(f.invalid(&rec("net"), format!("pair '{}' refers to a node beyond {n}", pm.name)));
+    }
+    let pair = ContactPair {
+        name: pm.name,
+        slave_kind: pm.slave_kind,
+        slave: pm.slave,
+        master: pm.master,
+        master_kind: pm.master_kind,
+        orders: pm.orders,
+        slave_nodes,
+        net: ControlNet { a, b, nodes },
+    };
+    let kv = pair.knot_vectors().map_err(|e| f.invalid(&rec("net"), format!("pair '{}': {e}", pair.name)))?;
+    for (d, kv) in kv.iter().enumerate() {
+        let name = rec(&format!("knots_{}", d + 1));
+        if f.f64s(&name, None)? != kv.knots() {
+            return Err(f.invalid(&name, format!("pair '{}': not the open uniform knot vector for {} points of order {}", pair.name, kv.n(), kv.order())));
+        }
+    }
+    Ok(pair)
 }
 
 /// A contact model in memory.
@@ -119,29 +179,13 @@ impl ContactModel {
         let mut w = StageWriter::new(FORMAT, MAJOR, MINOR);
         let meta = PairsMeta {
             source: self.source.clone(),
-            pairs: self
-                .pairs
-                .iter()
-                .map(|p| PairMeta {
-                    name: p.name.clone(),
-                    slave_kind: p.slave_kind,
-                    slave: p.slave.clone(),
-                    master: p.master.clone(),
-                    master_kind: p.master_kind,
-                    orders: p.orders,
-                    net: [p.net.a, p.net.b],
-                })
-                .collect(),
+            pairs: self.pairs.iter().map(pair_meta).collect(),
         };
         w.meta(&serde_yaml::to_string(&meta).expect("pairs metadata serialises"));
         w.meta(&scmesh::mesh_meta_yaml(&self.mesh, &self.source));
         scmesh::write_mesh_records(&mut w, &self.mesh, "mesh/");
         for (k, p) in self.pairs.iter().enumerate() {
-            let [k1, k2] = p.knot_vectors()?;
-            w.u32s(&format!("pair/{k}/slave_nodes"), &[p.slave_nodes.len() as u64], &p.slave_nodes);
-            w.u32s(&format!("pair/{k}/net"), &[p.net.b as u64, p.net.a as u64], &p.net.nodes);
-            w.f64s(&format!("pair/{k}/knots_1"), &[k1.knots().len() as u64], k1.knots());
-            w.f64s(&format!("pair/{k}/knots_2"), &[k2.knots().len() as u64], k2.knots());
+            write_pair_records(&mut w, k, p)?;
         }
         Ok(w.finish())
     }
@@ -152,47 +196,12 @@ impl ContactModel {
         write_atomic(path, &bytes)
     }
 
-    /// Decode and check: node indices in range, net size = a·b, orders fit the net,
-    /// knot vectors are the open uniform ones.
+    /// Decode and check each pair (see `read_pair`).
     pub fn from_stage(f: &StageFile) -> Result<Self, StageError> {
         let meta: PairsMeta = f.meta_as()?;
         let mesh_meta = f.meta.get(1).ok_or_else(|| f.invalid("META", "the mesh metadata record is missing"))?;
         let mesh = scmesh::read_mesh_records(f, "mesh/", mesh_meta)?;
-        let n = mesh.nodes.len();
-        let mut pairs = Vec::with_capacity(meta.pairs.len());
-        for (k, pm) in meta.pairs.into_iter().enumerate() {
-            let rec = |s: &str| format!("pair/{k}/{s}");
-            let slave_nodes = f.u32s(&rec("slave_nodes"), None)?.to_vec();
-            if slave_nodes.iter().any(|&v| v as usize >= n) {
-                return Err(f.invalid(&rec("slave_nodes"), format!("pair '{}' refers to a node beyond {n}", pm.name)));
-            }
-            let [a, b] = pm.net;
-            let nodes = f.u32s(&rec("net"), Some(a as u64))?.to_vec();
-            if nodes.len() != a * b {
-                return Err(f.invalid(&rec("net"), format!("pair '{}': metadata says a {a} × {b} net, the array holds {} ids", pm.name, nodes.len())));
-            }
-            if nodes.iter().any(|&v| v as usize >= n) {
-                return Err(f.invalid(&rec("net"), format!("pair '{}' refers to a node beyond {n}", pm.name)));
-            }
-            let pair = ContactPair {
-                name: pm.name,
-                slave_kind: pm.slave_kind,
-                slave: pm.slave,
-                master: pm.master,
-                master_kind: pm.master_kind,
-                orders: pm.orders,
-                slave_nodes,
-                net: ControlNet { a, b, nodes },
-            };
-            let kv = pair.knot_vectors().map_err(|e| f.invalid(&rec("net"), format!("pair '{}': {e}", pair.name)))?;
-            for (d, kv) in kv.iter().enumerate() {
-                let name = rec(&format!("knots_{}", d + 1));
-                if f.f64s(&name, None)? != kv.knots() {
-                    return Err(f.invalid(&name, format!("pair '{}': not the open uniform knot vector for {} points of order {}", pair.name, kv.n(), kv.order())));
-                }
-            }
-            pairs.push(pair);
-        }
+        let pairs = meta.pairs.into_iter().enumerate().map(|(k, pm)| read_pair(f, k, pm, mesh.nodes.len())).collect::<Result<_, _>>()?;
         Ok(Self { mesh, source: meta.source, pairs })
     }
 

@@ -10,13 +10,16 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
+use super::sccontact::{self, ContactPair, PairMeta};
 use super::scmesh;
 use super::stage::{write_atomic, StageError, StageFile, StageWriter};
 use crate::mesh::Mesh;
 
 pub const FORMAT: &str = "scres";
 pub const MAJOR: u32 = 1;
-pub const MINOR: u32 = 0;
+/// 1.1: contact pairs and per-increment contact state (files without them read as
+/// 1.0 did).
+pub const MINOR: u32 = 1;
 
 /// One Newton iteration, as logged.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
@@ -30,6 +33,15 @@ pub struct IterationLog {
     pub seconds_assembly: f64,
     pub seconds_factor: f64,
     pub seconds_solve: f64,
+    /// Contact search (projections, groups, pattern rebuild).
+    #[serde(default)]
+    pub seconds_contact: f64,
+    /// Slave nodes pressed into their master at this iterate (all pairs).
+    #[serde(default)]
+    pub contact_active: u32,
+    /// Uzawa update this Newton solve follows (0 = first solve of the increment).
+    #[serde(default)]
+    pub augmentation: u32,
 }
 
 /// Reaction force summed over a constrained node set.
@@ -39,6 +51,26 @@ pub struct Reaction {
     pub set: String,
     pub force: [f64; 3],
 }
+
+/// One contact pair at the end of an increment.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct PairSummary {
+    pub pair: String,
+    /// Force the master exerts on the slave body, Σ −t_N A_s n̄.
+    pub force: [f64; 3],
+    /// Active slave nodes.
+    pub active: u32,
+    /// Largest penetration −g_N of an active node.
+    pub max_penetration: f64,
+    /// Uzawa updates this increment needed.
+    pub augmentations: u32,
+    /// False when the augmentations ran out with the penetration still above tolerance.
+    pub penetration_converged: bool,
+}
+
+/// Columns of the per-slave-node contact state array `inc/<k>/pair/<p>/state`.
+pub const CONTACT_STATE_COLUMNS: [&str; 6] = ["g_n", "t_n", "lambda_n", "status", "xi_1", "xi_2"];
 
 /// What is known of one converged increment besides its arrays.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
@@ -50,6 +82,8 @@ pub struct IncrementInfo {
     pub iterations: Vec<IterationLog>,
     pub reactions: Vec<Reaction>,
     pub seconds_output: f64,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub contact: Vec<PairSummary>,
 }
 
 /// How the run ended (so far).
@@ -69,6 +103,9 @@ pub struct Increment {
     pub u: Vec<[f64; 3]>,
     /// Cauchy stress at the 8 Gauss points of every hexahedron, row-major 3×3.
     pub stress: Vec<[[f64; 9]; 8]>,
+    /// Per pair, per slave node: g_N, t_N, λ_N, status (−1 outside the patch, 0 open,
+    /// 1 active), ξ̄¹, ξ̄² (see [`CONTACT_STATE_COLUMNS`]).
+    pub contact: Vec<Vec<[f64; 6]>>,
 }
 
 #[derive(Debug, Serialize, Deserialize)]
@@ -81,6 +118,8 @@ struct ResultsMeta {
     /// The solve setup, as given (YAML text).
     setup: String,
     increments: Vec<IncrementInfo>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pairs: Vec<PairMeta>,
 }
 
 /// A results file in memory.
@@ -91,6 +130,8 @@ pub struct Results {
     pub setup: String,
     pub status: RunStatus,
     pub increments: Vec<Increment>,
+    /// The contact pairs of the model (empty without contact).
+    pub pairs: Vec<ContactPair>,
 }
 
 impl Results {
@@ -101,16 +142,25 @@ impl Results {
             status: self.status.clone(),
             setup: self.setup.clone(),
             increments: self.increments.iter().map(|i| i.info.clone()).collect(),
+            pairs: self.pairs.iter().map(sccontact::pair_meta).collect(),
         };
         w.meta(&serde_yaml::to_string(&meta).expect("results metadata serialises"));
         w.meta(&scmesh::mesh_meta_yaml(&self.mesh, &self.source));
         scmesh::write_mesh_records(&mut w, &self.mesh, "mesh/");
+        for (k, p) in self.pairs.iter().enumerate() {
+            // the pairs were checked when the contact model was read
+            sccontact::write_pair_records(&mut w, k, p).expect("contact pair orders fit their nets");
+        }
         let (n, m) = (self.mesh.nodes.len() as u64, self.mesh.hexes.len() as u64);
         for (k, inc) in self.increments.iter().enumerate() {
             let u: Vec<f64> = inc.u.iter().flatten().copied().collect();
             w.f64s(&format!("inc/{k}/u"), &[n, 3], &u);
             let s: Vec<f64> = inc.stress.iter().flatten().flatten().copied().collect();
             w.f64s(&format!("inc/{k}/stress"), &[m, 8, 9], &s);
+            for (p, state) in inc.contact.iter().enumerate() {
+                let v: Vec<f64> = state.iter().flatten().copied().collect();
+                w.f64s(&format!("inc/{k}/pair/{p}/state"), &[state.len() as u64, 6], &v);
+            }
         }
         w.finish()
     }
@@ -124,6 +174,7 @@ impl Results {
         let meta: ResultsMeta = f.meta_as()?;
         let mesh_meta = f.meta.get(1).ok_or_else(|| f.invalid("META", "the mesh metadata record is missing"))?;
         let mesh = scmesh::read_mesh_records(f, "mesh/", mesh_meta)?;
+        let pairs: Vec<ContactPair> = meta.pairs.into_iter().enumerate().map(|(k, pm)| sccontact::read_pair(f, k, pm, mesh.nodes.len())).collect::<Result<_, _>>()?;
         let mut increments = Vec::with_capacity(meta.increments.len());
         for (k, info) in meta.increments.into_iter().enumerate() {
             let u = f.f64s(&format!("inc/{k}/u"), Some(3))?;
@@ -139,9 +190,18 @@ impl Results {
                 .chunks_exact(72)
                 .map(|c| std::array::from_fn(|q| std::array::from_fn(|i| c[9 * q + i])))
                 .collect();
-            increments.push(Increment { info, u: u.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(), stress });
+            let mut contact = Vec::with_capacity(pairs.len());
+            for (p, pair) in pairs.iter().enumerate() {
+                let name = format!("inc/{k}/pair/{p}/state");
+                let v = f.f64s(&name, Some(6))?;
+                if v.len() != 6 * pair.slave_nodes.len() {
+                    return Err(f.invalid(&name, format!("expected {} slave nodes of pair '{}' × 6", pair.slave_nodes.len(), pair.name)));
+                }
+                contact.push(v.chunks_exact(6).map(|c| std::array::from_fn(|i| c[i])).collect());
+            }
+            increments.push(Increment { info, u: u.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(), stress, contact });
         }
-        Ok(Self { mesh, source: meta.source, setup: meta.setup, status: meta.status, increments })
+        Ok(Self { mesh, source: meta.source, setup: meta.setup, status: meta.status, increments, pairs })
     }
 
     pub fn read(path: &Path) -> Result<Self, StageError> {

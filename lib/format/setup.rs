@@ -185,6 +185,45 @@ pub enum LinearSolverChoice {
     Lu,
 }
 
+/// How a pair's normal constraint is enforced (paper sec. 4).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum Enforcement {
+    /// t_N = min(0, ε_N g_N): λ_N stays 0, the penetration is ε_N-dependent.
+    Penalty,
+    /// t_N = min(0, λ_N + ε_N g_N) with Uzawa updates λ_N ← t_N after each converged
+    /// Newton solve until the penetration is below the tolerance.
+    #[default]
+    AugmentedLagrangian,
+}
+
+/// Contact settings of one pair of the `.sccontact` model (by its name).
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactSetup {
+    /// Pair name, as given to `sc-tag`.
+    pub pair: String,
+    /// Normal penalty ε_N: traction per unit penetration (force/length³); for a slave
+    /// given as a node set (no tributary area) force per unit penetration.
+    pub eps_n: f64,
+    #[serde(default)]
+    pub enforcement: Enforcement,
+    /// Largest accepted penetration −g_N (a length), augmented Lagrangian only.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub penetration_tolerance: Option<f64>,
+    /// The same relative to the master's mean element edge length (default 1e-3 when
+    /// neither is given).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub penetration_tolerance_relative: Option<f64>,
+    /// Most Uzawa updates per increment.
+    #[serde(default = "default_max_augmentations")]
+    pub max_augmentations: u32,
+}
+
+fn default_max_augmentations() -> u32 {
+    20
+}
+
 /// The whole setup.
 #[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
@@ -202,6 +241,10 @@ pub struct SolveSetup {
     pub newton: NewtonSetup,
     #[serde(default)]
     pub linear_solver: LinearSolverChoice,
+    /// Settings per contact pair (input must then be a `.sccontact`).
+    #[serde(default)]
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub contact: Vec<ContactSetup>,
 }
 
 fn default_formulation() -> Formulation {

@@ -11,6 +11,10 @@ use std::time::Instant;
 
 use super::log::{IterationEvent, SolveLog};
 use super::newton::{gauss_stresses, IncrementFailure, Newton};
+use super::uzawa::solve_augmented;
+use crate::contact::pair::SlaveStatus;
+use crate::format::scres::PairSummary;
+use crate::format::setup::Enforcement;
 use super::problem::Problem;
 use crate::assembly::DOFS_PER_NODE;
 use crate::fem::element::hex8_min_jacobian;
@@ -69,6 +73,35 @@ fn worst_element(p: &Problem, results: &Results, failure: &IncrementFailure, tri
     }
 }
 
+/// Each pair's summary and per-slave state at the converged increment (states
+/// updated by the Uzawa loop).
+fn contact_results(newton: &Newton) -> (Vec<PairSummary>, Vec<Vec<[f64; 6]>>) {
+    let mut summaries = Vec::with_capacity(newton.contact.len());
+    let mut states = Vec::with_capacity(newton.contact.len());
+    for c in &newton.contact {
+        let f = c.total_force();
+        let max_penetration = c.max_penetration();
+        summaries.push(PairSummary {
+            pair: c.name.clone(),
+            force: [f[0], f[1], f[2]],
+            active: c.n_active() as u32,
+            max_penetration,
+            augmentations: c.augmentations,
+            penetration_converged: c.settings.enforcement == Enforcement::Penalty || max_penetration <= c.settings.penetration_tolerance,
+        });
+        states.push(
+            (0..c.slaves.len())
+                .map(|s| {
+                    let pr = &c.projections[s];
+                    let outside = c.status[s] == SlaveStatus::Outside;
+                    [if pr.g.is_finite() { pr.g } else { f64::NAN }, c.t_n[s], c.lambda_n[s], c.status[s].code(), if outside { f64::NAN } else { pr.xi[0] }, if outside { f64::NAN } else { pr.xi[1] }]
+                })
+                .collect(),
+        );
+    }
+    (summaries, states)
+}
+
 /// Run all increments; `results` holds the mesh and setup and receives the increments.
 pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &mut Results, out: &Outputs, log: &mut SolveLog) -> Result<SolveSummary, SolveError> {
     let p: &Problem = newton.problem;
@@ -104,9 +137,17 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
                         seconds_assembly: row.seconds_assembly,
                         seconds_factor: row.seconds_factor,
                         seconds_solve: row.seconds_solve,
+                        seconds_contact: row.seconds_contact,
+                        contact_active: row.contact_active,
+                        augmentation: row.augmentation,
                     })
                 };
-                newton.solve_increment(lambda, &mut trial, &mut on_it)
+                let mut notes = Vec::new();
+                let r = solve_augmented(newton, lambda, &mut trial, &mut on_it, &mut |s: &str| notes.push(s.to_string()));
+                for n in notes {
+                    log.line(&format!("increment {}/{n_inc}: {n}", k + 1));
+                }
+                r
             };
             match outcome {
                 Ok(conv) => {
@@ -121,10 +162,26 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
                     };
                     summary.iterations += conv.iterations.len().saturating_sub(1);
                     let reactions = newton.reactions().into_iter().map(|(set, force)| Reaction { set, force }).collect();
+                    let (summaries, states) = contact_results(newton);
+                    for s in &summaries {
+                        if !s.penetration_converged {
+                            log.line(&format!(
+                                "increment {}/{n_inc}: warning: pair '{}' still penetrates {:.3e} after {} augmentations (raise max_augmentations or eps_n)",
+                                k + 1,
+                                s.pair,
+                                s.max_penetration,
+                                s.augmentations
+                            ));
+                        }
+                    }
+                    for pair in &mut newton.contact {
+                        pair.commit();
+                    }
                     results.increments.push(Increment {
-                        info: IncrementInfo { load_factor: lambda, cutbacks: cutbacks_this, iterations: conv.iterations, reactions, seconds_output: 0.0 },
+                        info: IncrementInfo { load_factor: lambda, cutbacks: cutbacks_this, iterations: conv.iterations, reactions, seconds_output: 0.0, contact: summaries },
                         u: u.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
                         stress,
+                        contact: states,
                     });
                     write(results, log)?;
                     if let Some(last) = results.increments.last_mut() {
@@ -145,6 +202,9 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
                     lambda = target;
                 }
                 Err(failure) => {
+                    for pair in &mut newton.contact {
+                        pair.restore();
+                    }
                     failures += 1;
                     if failures > max_cutbacks {
                         return Err(stop(p, &trial, results, out, log, k + 1, lambda, lambda_prev, cutbacks_this, failure));

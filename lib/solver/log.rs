@@ -26,6 +26,11 @@ pub struct IterationEvent {
     pub seconds_assembly: f64,
     pub seconds_factor: f64,
     pub seconds_solve: f64,
+    pub seconds_contact: f64,
+    /// Slave nodes pressed into their master (all pairs).
+    pub contact_active: u32,
+    /// Uzawa update the Newton solve follows.
+    pub augmentation: u32,
 }
 
 /// Progress reporting plus the CSV history.
@@ -36,7 +41,7 @@ pub struct SolveLog {
 }
 
 impl SolveLog {
-    pub const CSV_HEADER: &'static str = "increment,load_factor,attempt,iteration,residual,energy,seconds_assembly,seconds_factor,seconds_solve\n";
+    pub const CSV_HEADER: &'static str = "increment,load_factor,attempt,augmentation,iteration,residual,energy,contact_active,seconds_contact,seconds_assembly,seconds_factor,seconds_solve\n";
 
     pub fn new(verbosity: Verbosity, n_increments: usize) -> Self {
         let bar = (verbosity == Verbosity::Normal && std::io::stderr().is_terminal()).then(|| {
@@ -62,18 +67,31 @@ impl SolveLog {
 
     pub fn iteration(&mut self, e: &IterationEvent) {
         self.csv.push_str(&format!(
-            "{},{:e},{},{},{:e},{:e},{:.6},{:.6},{:.6}\n",
-            e.increment, e.load_factor, e.attempt, e.iteration, e.residual, e.energy, e.seconds_assembly, e.seconds_factor, e.seconds_solve
+            "{},{:e},{},{},{},{:e},{:e},{},{:.6},{:.6},{:.6},{:.6}\n",
+            e.increment,
+            e.load_factor,
+            e.attempt,
+            e.augmentation,
+            e.iteration,
+            e.residual,
+            e.energy,
+            e.contact_active,
+            e.seconds_contact,
+            e.seconds_assembly,
+            e.seconds_factor,
+            e.seconds_solve
         ));
         let text = format!(
-            "increment {}/{} (λ = {:.4}{}) iteration {:>2}: residual {:.3e}, energy {:.3e}",
+            "increment {}/{} (λ = {:.4}{}{}) iteration {:>2}: residual {:.3e}, energy {:.3e}{}",
             e.increment,
             e.n_increments,
             e.load_factor,
             if e.attempt > 0 { format!(", cutback {}", e.attempt) } else { String::new() },
+            if e.augmentation > 0 { format!(", augmentation {}", e.augmentation) } else { String::new() },
             e.iteration,
             e.residual,
-            e.energy
+            e.energy,
+            if e.seconds_contact > 0.0 { format!(", {} contact nodes pressed", e.contact_active) } else { String::new() }
         );
         match &self.bar {
             Some(b) => b.set_message(text),

@@ -1,6 +1,7 @@
 //! Solvers: the linear-solver interface and its faer direct backend ([`linear`]),
 //! the static problem ([`problem`]), Newton–Raphson for one increment ([`newton`]),
-//! load stepping with cutbacks ([`increments`]), what the user sees ([`log`]), and a
+//! the augmented Lagrangian's Uzawa loop ([`uzawa`]), load
+//! stepping with cutbacks ([`increments`]), what the user sees ([`log`]), and a
 //! timing benchmark on a clamped elastic cube ([`bench`]).
 
 pub mod bench;
@@ -9,6 +10,7 @@ pub mod linear;
 pub mod log;
 pub mod newton;
 pub mod problem;
+pub mod uzawa;
 
 pub use linear::{
     FactorInfo, FaerDirect, FaerDirectOptions, Factorization, LinearSolver, LinearSolverError, SolverTimings, SymmetricStrategy, Symmetry,

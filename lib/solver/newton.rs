@@ -10,6 +10,8 @@ use nalgebra::{DMatrix, DVector, Vector3};
 
 use super::problem::Problem;
 use crate::assembly::{Assembly, AssemblyError, ElementFailure, NodeGroups, Pattern, PatternError, DOFS_PER_NODE};
+use crate::contact::element::ContactElementError;
+use crate::contact::pair::{PairError, PairSolver};
 use crate::fem::element::{hex8_gauss_stresses, hex8_residual_tangent, ElementError};
 use crate::fem::pressure::{follower_pressure_force_stiffness, FaceMatrix, FaceVector};
 use crate::format::scres::IterationLog;
@@ -27,6 +29,26 @@ pub enum IncrementFailure {
     Diverged { iteration: u32, residual: f64 },
     #[error("iteration {iteration}: linear solver: {error}")]
     Linear { iteration: u32, error: LinearSolverError },
+    #[error("iteration {iteration}: contact pair '{pair}', slave node {node_tag}: {error}")]
+    Contact { iteration: u32, pair: String, node_tag: u64, error: ContactElementError },
+    #[error("iteration {iteration}: {message}")]
+    ContactSetup { iteration: u32, message: String },
+}
+
+/// A local (element-level) failure during assembly.
+#[derive(Debug, Clone)]
+enum LocalFailure {
+    Hex(ElementError),
+    Contact(ContactElementError),
+}
+
+/// What a group of the sparsity pattern is.
+#[derive(Debug, Clone, Copy)]
+enum GroupOwner {
+    /// A follower-pressure face (index into `problem.pressure_faces`).
+    Pressure(usize),
+    /// A contact element: (pair, slave index in the pair).
+    Contact(usize, usize),
 }
 
 /// Setting the solver up failed (a mesh too large for the assembly's numbering, …).
@@ -38,6 +60,8 @@ pub enum SetupFailure {
     Assembly(#[from] AssemblyError),
     #[error(transparent)]
     Linear(#[from] LinearSolverError),
+    #[error(transparent)]
+    Contact(#[from] PairError),
 }
 
 /// Newton workspace for one problem: the pattern, its symbolic factorization and the
@@ -51,6 +75,12 @@ pub struct Newton<'p> {
     residual: Vec<f64>,
     rhs: Vec<f64>,
     r_free: Vec<f64>,
+    /// The contact pairs' state (search, multipliers, active sets).
+    pub contact: Vec<PairSolver>,
+    /// Owner of every group of `pattern`.
+    owners: Vec<GroupOwner>,
+    /// Times the pattern was rebuilt because contact groups changed.
+    pub pattern_rebuilds: u32,
 }
 
 /// A converged increment's iteration history.
@@ -60,7 +90,12 @@ pub struct Converged {
 
 impl<'p> Newton<'p> {
     pub fn new(problem: &'p Problem, settings: NewtonSetup, choice: LinearSolverChoice) -> Result<Self, SetupFailure> {
-        let groups: NodeGroups = problem.pressure_faces.iter().map(|f| &f.nodes[..]).collect();
+        let mut contact = Vec::with_capacity(problem.contact.len());
+        for def in &problem.contact {
+            contact.push(PairSolver::new(def, &problem.X)?);
+        }
+        let mut owners = Vec::new();
+        let groups = contact_groups(problem, &mut contact, &vec![0.0; DOFS_PER_NODE * problem.n_nodes()], &mut owners)?;
         let pattern = Pattern::build(problem.dofs.clone(), &problem.hexes, groups)?;
         let assembly = Assembly::new(&pattern)?;
         let (symmetry, strategy) = match choice {
@@ -73,7 +108,42 @@ impl<'p> Newton<'p> {
         linear.analyse(pattern.symbolic(), symmetry)?;
         let n = DOFS_PER_NODE * problem.n_nodes();
         let n_free = pattern.n_free();
-        Ok(Self { problem, settings, pattern, assembly, linear, residual: vec![0.0; n], rhs: vec![0.0; n_free], r_free: vec![0.0; n_free] })
+        Ok(Self {
+            problem,
+            settings,
+            pattern,
+            assembly,
+            linear,
+            residual: vec![0.0; n],
+            rhs: vec![0.0; n_free],
+            r_free: vec![0.0; n_free],
+            contact,
+            owners,
+            pattern_rebuilds: 0,
+        })
+    }
+
+    /// Contact search at `u`; rebuilds the pattern (and the solver's symbolic
+    /// analysis) if the contact groups changed.
+    fn contact_search(&mut self, u: &[f64], iteration: u32) -> Result<(), IncrementFailure> {
+        if self.contact.is_empty() {
+            return Ok(());
+        }
+        let fail = |message: String| IncrementFailure::ContactSetup { iteration, message };
+        let groups = contact_groups(self.problem, &mut self.contact, u, &mut self.owners).map_err(|e| fail(e.to_string()))?;
+        if &groups != self.pattern.groups() {
+            self.pattern = self.pattern.with_groups(groups).map_err(|e| fail(e.to_string()))?;
+            self.assembly = Assembly::new(&self.pattern).map_err(|e| fail(e.to_string()))?;
+            let symmetry = if self.problem.symmetric() { Symmetry::Symmetric } else { Symmetry::General };
+            self.linear.analyse(self.pattern.symbolic(), symmetry).map_err(|error| IncrementFailure::Linear { iteration, error })?;
+            self.pattern_rebuilds += 1;
+        }
+        Ok(())
+    }
+
+    /// Slave nodes pressed into the master at the last search, over all pairs.
+    pub fn n_contact_pressed(&self) -> usize {
+        self.contact.iter().map(|c| c.n_pressed()).sum()
     }
 
     pub fn n_free(&self) -> usize {
@@ -88,16 +158,21 @@ impl<'p> Newton<'p> {
         self.linear.name()
     }
 
-    /// Assemble K_ff and the full residual R = f_int − f_ext(λ) at `u`.
-    fn assemble(&mut self, u: &[f64], lambda: f64) -> Result<(), (usize, ElementError)> {
+    /// Assemble K_ff and the full residual R = f_int − f_ext(λ) at `u` (after
+    /// [`Self::contact_search`] at the same `u`).
+    fn assemble(&mut self, u: &[f64], lambda: f64) -> Result<(), AssemblyFailure> {
         let p = self.problem;
         let hex = |e: usize, r: &mut _, k: &mut _| {
             let (X, ue) = p.gather(e, u);
-            hex8_residual_tangent(&X, &ue, &p.materials[p.hex_material[e] as usize], p.formulation, r, k)
+            hex8_residual_tangent(&X, &ue, &p.materials[p.hex_material[e] as usize], p.formulation, r, k).map_err(LocalFailure::Hex)
         };
+        let (owners, contact) = (&self.owners, &self.contact);
         // Follower pressure: an external force, so the residual gets −f and the tangent −∂f/∂x.
-        let face = |g: usize, r: &mut DVector<f64>, k: &mut DMatrix<f64>| {
-            let f = &p.pressure_faces[g];
+        let group = |g: usize, r: &mut DVector<f64>, k: &mut DMatrix<f64>| {
+            let f = match owners[g] {
+                GroupOwner::Pressure(i) => &p.pressure_faces[i],
+                GroupOwner::Contact(pair, s) => return contact[pair].element(s, r, k).map(|_| ()).map_err(LocalFailure::Contact),
+            };
             let x: [Vector3<f64>; 4] = std::array::from_fn(|a| {
                 let n = f.nodes[a] as usize;
                 let d = DOFS_PER_NODE * n;
@@ -113,11 +188,18 @@ impl<'p> Newton<'p> {
             }
             Ok(())
         };
-        let res = self.assembly.assemble_with_groups(&self.pattern, hex, face);
+        let res = self.assembly.assemble_with_groups(&self.pattern, hex, group);
         let full = match res {
             Ok((_, r)) => r,
-            Err(ElementFailure::Hex { element, error }) => return Err((element, error)),
-            Err(ElementFailure::Group { group, error }) => return Err((group, error)),
+            Err(ElementFailure::Hex { element, error }) | Err(ElementFailure::Group { group: element, error }) => {
+                return Err(match error {
+                    LocalFailure::Hex(error) => AssemblyFailure::Hex(element, error),
+                    LocalFailure::Contact(error) => match owners[element] {
+                        GroupOwner::Contact(pair, s) => AssemblyFailure::Contact(pair, s, error),
+                        GroupOwner::Pressure(_) => unreachable!("pressure faces do not return contact errors"),
+                    },
+                })
+            }
         };
         for ((out, r), f) in self.residual.iter_mut().zip(full).zip(&p.f_ext) {
             *out = r - lambda * f;
@@ -140,7 +222,16 @@ impl<'p> Newton<'p> {
         let mut max_reaction: f64 = 0.0;
         for iteration in 0..=self.settings.max_iterations {
             let t = Instant::now();
-            self.assemble(u, lambda).map_err(|(element, error)| IncrementFailure::Element { iteration, element, error })?;
+            self.contact_search(u, iteration)?;
+            let seconds_contact = t.elapsed().as_secs_f64();
+            let t = Instant::now();
+            self.assemble(u, lambda).map_err(|f| match f {
+                AssemblyFailure::Hex(element, error) => IncrementFailure::Element { iteration, element, error },
+                AssemblyFailure::Contact(pair, s, error) => {
+                    let c = &self.contact[pair];
+                    IncrementFailure::Contact { iteration, pair: c.name.clone(), node_tag: p.node_tags.get(c.slaves[s] as usize).copied().unwrap_or(c.slaves[s] as u64), error }
+                }
+            })?;
             let seconds_assembly = t.elapsed().as_secs_f64();
             let dofs = &p.dofs;
             dofs.gather_free(&self.residual, &mut self.rhs);
@@ -165,7 +256,17 @@ impl<'p> Newton<'p> {
                 energy = if energy0 > 0.0 { e / energy0 } else { 0.0 };
             }
             let converged = residual <= self.settings.residual_tolerance && (iteration == 0 || energy <= self.settings.energy_tolerance);
-            let mut row = IterationLog { iteration, residual, energy: if iteration == 0 { f64::NAN } else { energy }, seconds_assembly, seconds_factor: 0.0, seconds_solve: 0.0 };
+            let mut row = IterationLog {
+                iteration,
+                residual,
+                energy: if iteration == 0 { f64::NAN } else { energy },
+                seconds_assembly,
+                seconds_factor: 0.0,
+                seconds_solve: 0.0,
+                seconds_contact,
+                contact_active: self.n_contact_pressed() as u32,
+                augmentation: self.contact.iter().map(|c| c.augmentations).max().unwrap_or(0),
+            };
             if converged || r_norm == 0.0 {
                 on_iteration(&row);
                 log.push(row);
@@ -214,6 +315,33 @@ impl<'p> Newton<'p> {
             })
             .collect()
     }
+}
+
+/// Which local evaluation failed during assembly.
+enum AssemblyFailure {
+    /// (hexahedron, error)
+    Hex(usize, ElementError),
+    /// (pair, slave index, error)
+    Contact(usize, usize, ContactElementError),
+}
+
+/// Contact search of every pair at `u` and the node groups of the pattern: the
+/// follower-pressure faces, then every contact element; `owners` says which is which.
+fn contact_groups(p: &Problem, contact: &mut [PairSolver], u: &[f64], owners: &mut Vec<GroupOwner>) -> Result<NodeGroups, PairError> {
+    let mut groups: NodeGroups = p.pressure_faces.iter().map(|f| &f.nodes[..]).collect();
+    owners.clear();
+    owners.extend((0..p.pressure_faces.len()).map(GroupOwner::Pressure));
+    let mut slaves = Vec::new();
+    for (k, pair) in contact.iter_mut().enumerate() {
+        pair.search(|n| {
+            let d = DOFS_PER_NODE * n as usize;
+            p.X[n as usize] + Vector3::new(u[d], u[d + 1], u[d + 2])
+        })?;
+        slaves.clear();
+        pair.push_groups(&mut groups, &mut slaves);
+        owners.extend(slaves.iter().map(|&s| GroupOwner::Contact(k, s)));
+    }
+    Ok(groups)
 }
 
 /// Cauchy stress at the Gauss points of every element (row-major 3×3), in parallel.

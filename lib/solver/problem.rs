@@ -8,6 +8,9 @@
 use nalgebra::Vector3;
 
 use crate::assembly::{DofMap, DOFS_PER_NODE};
+use crate::contact::pair::PairSettings;
+use crate::contact::tributary::tributary_areas;
+use crate::format::sccontact::{ContactPair, SlaveKind};
 use crate::fem::element::Formulation;
 use crate::format::setup::{self, ModelName, SolveSetup};
 use crate::material::linear::LinearElastic;
@@ -40,6 +43,17 @@ pub struct PressureFace {
     pub p: f64,
 }
 
+/// A contact pair of the model with its settings from the setup.
+#[derive(Debug, Clone)]
+pub struct ContactDefinition {
+    pub pair: ContactPair,
+    pub settings: PairSettings,
+    /// Tributary area of each slave node (eq. 6.1), order of `pair.slave_nodes`.
+    pub areas: Vec<f64>,
+    /// Mean edge length of the master net (reference configuration).
+    pub h_master: f64,
+}
+
 /// The problem.
 pub struct Problem {
     /// Reference coordinates.
@@ -57,6 +71,10 @@ pub struct Problem {
     pub pressure_faces: Vec<PressureFace>,
     /// Constrained node sets, for reaction output: (name, nodes).
     pub reaction_sets: Vec<(String, Vec<u32>)>,
+    /// Contact pairs (empty without a contact model).
+    pub contact: Vec<ContactDefinition>,
+    /// gmsh tag of every node, for messages.
+    pub node_tags: Vec<u64>,
 }
 
 fn names(v: Vec<&str>) -> String {
@@ -93,9 +111,89 @@ fn material(file: &str, m: &setup::MaterialSetup) -> Result<MaterialModel, Probl
     Ok(model)
 }
 
+/// Match the setup's `contact` entries with the model's pairs and resolve them.
+fn contact_definitions(mesh: &Mesh, pairs: &[ContactPair], setup: &SolveSetup, file: &str) -> Result<Vec<ContactDefinition>, ProblemError> {
+    let invalid = |message: String| ProblemError::Invalid { file: file.into(), message };
+    let pair_names = || names(pairs.iter().map(|p| p.name.as_str()).collect());
+    for (i, c) in setup.contact.iter().enumerate() {
+        if !pairs.iter().any(|p| p.name == c.pair) {
+            return Err(if pairs.is_empty() {
+                invalid(format!("contact entry {} names pair '{}', but the input has no contact pairs (give the .sccontact written by sc-tag as input)", i + 1, c.pair))
+            } else {
+                ProblemError::UnknownName { file: file.into(), what: "contact pair", name: c.pair.clone(), available: pair_names() }
+            });
+        }
+        if setup.contact[..i].iter().any(|o| o.pair == c.pair) {
+            return Err(invalid(format!("contact pair '{}' has two entries under `contact`", c.pair)));
+        }
+    }
+    let mut out = Vec::with_capacity(pairs.len());
+    for pair in pairs {
+        let Some(c) = setup.contact.iter().find(|c| c.pair == pair.name) else {
+            return Err(invalid(format!("contact pair '{}' has no entry under `contact` (it needs at least `eps_n`)", pair.name)));
+        };
+        let bad = |m: String| invalid(format!("contact pair '{}': {m}", pair.name));
+        if !(c.eps_n.is_finite() && c.eps_n > 0.0) {
+            return Err(bad(format!("eps_n must be a positive number, found {}", c.eps_n)));
+        }
+        for (key, v) in [("penetration_tolerance", c.penetration_tolerance), ("penetration_tolerance_relative", c.penetration_tolerance_relative)] {
+            if let Some(v) = v {
+                if !(v.is_finite() && v > 0.0) {
+                    return Err(bad(format!("{key} must be a positive number, found {v}")));
+                }
+            }
+        }
+        let areas = tributary_areas(mesh, &pair.slave_nodes, (pair.slave_kind == SlaveKind::FaceSet).then_some(pair.slave.as_str()));
+        let h = mean_net_edge(mesh, pair);
+        let penetration_tolerance = match (c.penetration_tolerance, c.penetration_tolerance_relative) {
+            (Some(_), Some(_)) => return Err(bad("give `penetration_tolerance` or `penetration_tolerance_relative`, not both".into())),
+            (Some(t), None) => t,
+            (None, Some(r)) => r * h,
+            (None, None) => 1e-3 * h,
+        };
+        out.push(ContactDefinition {
+            pair: pair.clone(),
+            settings: PairSettings { eps_n: c.eps_n, enforcement: c.enforcement, penetration_tolerance, max_augmentations: c.max_augmentations },
+            areas,
+            h_master: h,
+        });
+    }
+    Ok(out)
+}
+
+/// Mean edge length of a pair's master net (reference configuration).
+fn mean_net_edge(mesh: &Mesh, pair: &ContactPair) -> f64 {
+    let (a, b) = (pair.net.a, pair.net.b);
+    let x = |i: usize, j: usize| Vector3::from(mesh.nodes[pair.net.at(i, j) as usize]);
+    let (mut sum, mut n) = (0.0, 0usize);
+    for j in 0..b {
+        for i in 0..a {
+            if i + 1 < a {
+                sum += (x(i + 1, j) - x(i, j)).norm();
+                n += 1;
+            }
+            if j + 1 < b {
+                sum += (x(i, j + 1) - x(i, j)).norm();
+                n += 1;
+            }
+        }
+    }
+    if n > 0 {
+        sum / n as f64
+    } else {
+        1.0
+    }
+}
+
 impl Problem {
-    /// Build and check the problem; `file` names the setup in messages.
+    /// Build and check the problem without contact; `file` names the setup in messages.
     pub fn new(mesh: &Mesh, setup: &SolveSetup, file: &str) -> Result<Self, ProblemError> {
+        Self::with_contact(mesh, &[], setup, file)
+    }
+
+    /// Build and check the problem with the contact `pairs` of a `.sccontact` model:
+    /// every pair needs exactly one `contact` entry in the setup and vice versa.
+    pub fn with_contact(mesh: &Mesh, pairs: &[ContactPair], setup: &SolveSetup, file: &str) -> Result<Self, ProblemError> {
         let unknown = |what: &'static str, name: &str, available: Vec<&str>| ProblemError::UnknownName {
             file: file.into(),
             what,
@@ -190,6 +288,7 @@ impl Problem {
                 }
             }
         }
+        let contact = contact_definitions(mesh, pairs, setup, file)?;
         Ok(Self {
             X: mesh.nodes.iter().map(|p| Vector3::new(p[0], p[1], p[2])).collect(),
             hexes: mesh.hexes.clone(),
@@ -204,6 +303,8 @@ impl Problem {
             f_ext,
             pressure_faces,
             reaction_sets,
+            contact,
+            node_tags: mesh.node_tags.clone(),
         })
     }
 
@@ -223,7 +324,8 @@ impl Problem {
         (X, ue)
     }
 
-    /// True if the tangent is symmetric (no follower pressure).
+    /// True if the tangent is symmetric (no follower pressure; frictionless contact
+    /// keeps it symmetric).
     pub fn symmetric(&self) -> bool {
         self.pressure_faces.is_empty()
     }

@@ -86,9 +86,10 @@ pub fn write_results_pvd(results: &Results, output: &Path) -> Result<String, Sta
     let mesh = &results.mesh;
     let mut entries = Vec::new();
     let zero = scres::Increment {
-        info: scres::IncrementInfo { load_factor: 0.0, cutbacks: 0, iterations: vec![], reactions: vec![], seconds_output: 0.0 },
+        info: scres::IncrementInfo { load_factor: 0.0, cutbacks: 0, iterations: vec![], reactions: vec![], seconds_output: 0.0, contact: vec![] },
         u: vec![[0.0; 3]; mesh.nodes.len()],
         stress: vec![[[0.0; 9]; 8]; mesh.hexes.len()],
+        contact: vec![],
     };
     for (k, inc) in std::iter::once(&zero).chain(results.increments.iter()).enumerate() {
         let name = format!("{stem}_{k}.vtu");
@@ -98,11 +99,45 @@ pub fn write_results_pvd(results: &Results, output: &Path) -> Result<String, Sta
         let nodal = stresses::nodal_average(mesh, &elem);
         push_stress_fields(&mut g.point_data, &nodal);
         push_stress_fields(&mut g.cell_data, &elem);
+        if !results.pairs.is_empty() {
+            push_contact_fields(&mut g.point_data, mesh.nodes.len(), results, &inc.contact);
+        }
         g.write_vtu(&dir.join(&name))?;
         entries.push((inc.info.load_factor, name));
     }
     vtk::write_pvd(output, &entries)?;
     Ok(format!("wrote {} ({} increments + the undeformed state)", output.display(), results.increments.len()))
+}
+
+/// Contact point data on the slave nodes of every pair (state columns of
+/// [`scres::CONTACT_STATE_COLUMNS`]): `contact_pressure` = −t_N (≥ 0, summed over
+/// pairs), `contact_gap` g_N, `contact_lambda_n` λ_N, `contact_status` (1 active,
+/// 0 open, −1 outside the master patch, −2 not a slave node). Gap and λ_N are NaN
+/// off the slave nodes. An increment without states (the undeformed state) gets
+/// open slave nodes with NaN gaps, so every step of a series has the same arrays.
+fn push_contact_fields(out: &mut Vec<vtk::Field>, n: usize, results: &Results, states: &[Vec<[f64; 6]>]) {
+    let mut pressure = vec![0.0; n];
+    let mut gap = vec![f64::NAN; n];
+    let mut lambda = vec![f64::NAN; n];
+    let mut status = vec![-2.0; n];
+    for (p, pair) in results.pairs.iter().enumerate() {
+        for (s, &node) in pair.slave_nodes.iter().enumerate() {
+            let i = node as usize;
+            match states.get(p).and_then(|st| st.get(s)) {
+                Some(&[g, t, l, code, _, _]) => {
+                    pressure[i] -= t;
+                    gap[i] = g;
+                    lambda[i] = l;
+                    status[i] = code;
+                }
+                None => status[i] = 0.0,
+            }
+        }
+    }
+    out.push(vtk::Field::scalar_f64("contact_pressure", pressure));
+    out.push(vtk::Field::scalar_f64("contact_gap", gap));
+    out.push(vtk::Field::scalar_f64("contact_lambda_n", lambda));
+    out.push(vtk::Field::scalar_f64("contact_status", status));
 }
 
 /// Sub-quads per knot span (B-spline) or facet, per direction, in the tessellated

@@ -5,7 +5,9 @@ use std::path::Path;
 use std::time::Instant;
 
 use super::StageRunError;
+use crate::format::sccontact::{self, ContactModel};
 use crate::format::scmesh;
+use crate::format::stage::StageFile;
 use crate::format::scres::{Results, RunStatus};
 use crate::format::setup::SolveSetup;
 use crate::solver::increments::{self, Outputs};
@@ -33,11 +35,37 @@ pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, 
         return Err(StageRunError::Usage("sc-solve writes its results after every increment: give a file with -o, not -".into()));
     }
     let start = Instant::now();
-    let mesh = scmesh::read(input)?;
-    let problem = Problem::new(&mesh, setup, setup_name)?;
+    let file = StageFile::read_known(input, &[(scmesh::FORMAT, scmesh::MAJOR), (sccontact::FORMAT, sccontact::MAJOR)])?;
+    let (mesh, pairs) = match file.format.as_str() {
+        scmesh::FORMAT => (scmesh::from_stage(&file)?, Vec::new()),
+        sccontact::FORMAT => {
+            let model = ContactModel::from_stage(&file)?;
+            (model.mesh, model.pairs)
+        }
+        other => return Err(StageRunError::Usage(format!("{}: a {other} file; sc-solve reads a mesh (.scmesh) or a contact model (.sccontact)", input.display()))),
+    };
+    let problem = Problem::with_contact(&mesh, &pairs, setup, setup_name)?;
     let factors = setup.load_factors(setup_name)?;
     let mut newton = Newton::new(&problem, setup.newton.clone(), setup.linear_solver)?;
     let mut log = SolveLog::new(verbosity, factors.len());
+    for c in &newton.contact {
+        let s = &c.settings;
+        log.line(&format!(
+            "contact pair '{}': {} slave nodes, {} master, ε_N = {:e}, {}{}",
+            c.name,
+            c.slaves.len(),
+            c.master_kind.name(),
+            s.eps_n,
+            match s.enforcement {
+                crate::format::setup::Enforcement::Penalty => "penalty",
+                crate::format::setup::Enforcement::AugmentedLagrangian => "augmented Lagrangian",
+            },
+            match s.enforcement {
+                crate::format::setup::Enforcement::Penalty => String::new(),
+                _ => format!(" (penetration tolerance {:e}, at most {} augmentations)", s.penetration_tolerance, s.max_augmentations),
+            }
+        ));
+    }
     log.line(&format!(
         "{}: {} nodes, {} hexahedra, {} free dofs, {} nonzeros, {} increments, linear solver {}",
         input.display(),
@@ -54,6 +82,7 @@ pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, 
         status: RunStatus::Running,
         increments: Vec::new(),
         mesh,
+        pairs,
     };
     let outputs = Outputs { results: output, csv };
     let summary = increments::solve(&mut newton, &factors, setup.increments.max_cutbacks, &mut results, &outputs, &mut log);

@@ -1,0 +1,279 @@
+//! One contact pair during the solve: the master surface following its body, the
+//! closest-point projection of every slave node onto it (eq. 2.2), the multipliers
+//! λ_N of the augmented Lagrangian and their Uzawa update (sec. 4), and the contact
+//! element of each slave node that carries or may carry force.
+//!
+//! Per Newton iterate the solver calls, in order:
+//! 1. [`PairSolver::search`]: move the control net to the current node positions,
+//!    project every slave node (span tree + Newton, near-linear in the number of
+//!    slaves), evaluate the master at each foot point;
+//! 2. [`PairSolver::push_groups`]: the node group `[slave, control points with
+//!    nonzero basis at ξ̄]` of every slave that is inside the patch and within the
+//!    capture distance (or holds a multiplier) — the contact elements of the
+//!    sparsity pattern, which changes only when such a list changes;
+//! 3. [`PairSolver::element`]: residual and tangent of one group (eq. 6.2, 6.5).
+//!
+//! After Newton converges, [`PairSolver::update_states`] records g_N, t_N and the
+//! active set, and [`PairSolver::augment`] performs the Uzawa update λ_N ← t_N.
+
+use nalgebra::{DMatrix, DVector};
+use rayon::prelude::*;
+
+use super::element::{normal_contact, ContactElementError, ContactState, NormalLaw};
+use crate::format::sccontact::MasterKind;
+use crate::solver::problem::ContactDefinition;
+use crate::format::setup::Enforcement;
+use crate::spline::{BSplinePatch, BSplineProjector, FacetProjector, FacetSurface, Projection, SplineError, SurfacePoint, Vec3};
+
+/// Settings of a pair, resolved (absolute lengths).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PairSettings {
+    pub eps_n: f64,
+    pub enforcement: Enforcement,
+    /// Largest accepted penetration (length), augmented Lagrangian.
+    pub penetration_tolerance: f64,
+    pub max_augmentations: u32,
+}
+
+/// Where a slave node stands after the last search / state update.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SlaveStatus {
+    /// The foot point lies beyond the patch edge (or the projection failed): no contact.
+    Outside,
+    /// Inside, λ_N + ε_N g_N ≥ 0: no pressure.
+    Open,
+    /// Inside, λ_N + ε_N g_N < 0: t_N < 0.
+    Active,
+}
+
+impl SlaveStatus {
+    /// The code written to results files: −1 outside, 0 open, 1 active.
+    pub fn code(self) -> f64 {
+        match self {
+            Self::Outside => -1.0,
+            Self::Open => 0.0,
+            Self::Active => 1.0,
+        }
+    }
+}
+
+/// The master as the projection sees it.
+enum Projector {
+    BSpline(BSplineProjector),
+    Facet(FacetProjector),
+}
+
+impl Projector {
+    fn update(&mut self, x: &[Vec3]) -> Result<(), SplineError> {
+        match self {
+            Self::BSpline(p) => p.update(x),
+            Self::Facet(p) => p.update(x),
+        }
+    }
+    fn project(&self, p: &Vec3) -> Projection {
+        match self {
+            Self::BSpline(pr) => pr.project(p),
+            Self::Facet(pr) => pr.project(p),
+        }
+    }
+    fn evaluate(&self, xi: [f64; 2]) -> SurfacePoint {
+        match self {
+            Self::BSpline(p) => p.evaluate(xi),
+            Self::Facet(p) => p.evaluate(xi),
+        }
+    }
+}
+
+/// A pair that cannot be set up.
+#[derive(Debug, thiserror::Error)]
+pub enum PairError {
+    #[error("contact pair '{pair}': master surface: {source}")]
+    Master { pair: String, source: SplineError },
+}
+
+/// The state of one pair.
+pub struct PairSolver {
+    pub name: String,
+    pub settings: PairSettings,
+    pub master_kind: MasterKind,
+    /// Mesh node of every control point, `i + a·j`.
+    net: Vec<u32>,
+    projector: Projector,
+    x_net: Vec<Vec3>,
+    /// Slave node ids (sorted) and their tributary areas A_s (eq. 6.1).
+    pub slaves: Vec<u32>,
+    pub areas: Vec<f64>,
+    /// λ_N of this increment's current Uzawa iterate, and of the last converged increment.
+    pub lambda_n: Vec<f64>,
+    lambda_committed: Vec<f64>,
+    /// Last search: projections, surface points at ξ̄, slave positions.
+    pub projections: Vec<Projection>,
+    points: Vec<SurfacePoint>,
+    x_slave: Vec<Vec3>,
+    /// After [`Self::update_states`]: t_N and the status of every slave.
+    pub t_n: Vec<f64>,
+    pub status: Vec<SlaveStatus>,
+    /// Mean edge length of the master net in the reference configuration.
+    pub h_master: f64,
+    /// Slaves inside the patch closer than this (or holding λ_N < 0) get a group.
+    capture: f64,
+    /// See [`NormalLaw::touch`].
+    touch: f64,
+    /// Uzawa updates made in the current increment.
+    pub augmentations: u32,
+}
+
+impl PairSolver {
+    /// `x_ref` are the reference coordinates of all mesh nodes.
+    pub fn new(def: &ContactDefinition, x_ref: &[Vec3]) -> Result<Self, PairError> {
+        let pair = &def.pair;
+        let err = |source| PairError::Master { pair: pair.name.clone(), source };
+        let x_net: Vec<Vec3> = pair.net.nodes.iter().map(|&n| x_ref[n as usize]).collect();
+        let (a, b) = (pair.net.a, pair.net.b);
+        let projector = match pair.master_kind {
+            MasterKind::Bspline => Projector::BSpline(BSplineProjector::new(BSplinePatch::new(a, b, pair.orders[0], pair.orders[1]).map_err(err)?, &x_net).map_err(err)?),
+            MasterKind::Facet => Projector::Facet(FacetProjector::new(FacetSurface::new(a, b).map_err(err)?, &x_net).map_err(err)?),
+        };
+        let h_master = def.h_master;
+        let settings = def.settings;
+        let areas = def.areas.clone();
+        let n = pair.slave_nodes.len();
+        Ok(Self {
+            name: pair.name.clone(),
+            settings,
+            master_kind: pair.master_kind,
+            net: pair.net.nodes.clone(),
+            projector,
+            x_net,
+            slaves: pair.slave_nodes.clone(),
+            areas,
+            lambda_n: vec![0.0; n],
+            lambda_committed: vec![0.0; n],
+            projections: vec![Projection { xi: [0.0; 2], x_bar: Vec3::zeros(), g: f64::INFINITY, inside: false, iterations: 0, converged: false }; n],
+            points: vec![SurfacePoint::default(); n],
+            x_slave: vec![Vec3::zeros(); n],
+            t_n: vec![0.0; n],
+            status: vec![SlaveStatus::Outside; n],
+            h_master,
+            capture: 0.5 * h_master,
+            touch: 1e-8 * h_master,
+            augmentations: 0,
+        })
+    }
+
+    /// Closest-point search at the current positions `x(node)` of all nodes.
+    pub fn search(&mut self, x: impl Fn(u32) -> Vec3 + Sync) -> Result<(), PairError> {
+        for (xn, &node) in self.x_net.iter_mut().zip(&self.net) {
+            *xn = x(node);
+        }
+        self.projector.update(&self.x_net).map_err(|source| PairError::Master { pair: self.name.clone(), source })?;
+        let projector = &self.projector;
+        self.x_slave.iter_mut().zip(&self.slaves).for_each(|(xs, &node)| *xs = x(node));
+        self.projections
+            .par_iter_mut()
+            .zip(self.points.par_iter_mut())
+            .zip(self.x_slave.par_iter())
+            .with_min_len(64)
+            .for_each(|((proj, sp), xs)| {
+                *proj = projector.project(xs);
+                if proj.inside && proj.converged {
+                    *sp = projector.evaluate(proj.xi);
+                }
+            });
+        Ok(())
+    }
+
+    fn usable(&self, s: usize) -> bool {
+        let p = &self.projections[s];
+        p.inside && p.converged && self.points[s].n_bar.iter().all(|v| v.is_finite())
+    }
+
+    /// Appends the node group of every slave that needs a contact element now, and
+    /// its slave index to `owners`.
+    pub fn push_groups(&self, groups: &mut crate::assembly::NodeGroups, owners: &mut Vec<usize>) {
+        let mut nodes = Vec::with_capacity(1 + crate::spline::MAX_NODES);
+        for s in 0..self.slaves.len() {
+            if !self.usable(s) || (self.projections[s].g >= self.capture && self.lambda_n[s] >= 0.0) {
+                continue;
+            }
+            nodes.clear();
+            nodes.push(self.slaves[s]);
+            nodes.extend(self.points[s].basis.nodes().iter().map(|&k| self.net[k]));
+            groups.push(&nodes);
+            owners.push(s);
+        }
+    }
+
+    /// The contact element of slave `s` (group nodes `[slave, control points]`).
+    pub fn element(&self, s: usize, r: &mut DVector<f64>, k: &mut DMatrix<f64>) -> Result<ContactState, ContactElementError> {
+        let law = NormalLaw { lambda_n: self.lambda_n[s], eps_n: self.settings.eps_n, area: self.areas[s], touch: self.touch };
+        normal_contact(&self.x_slave[s], &self.points[s], &law, r, k)
+    }
+
+    /// t_N and status of every slave at the last search.
+    pub fn update_states(&mut self) {
+        for s in 0..self.slaves.len() {
+            if !self.usable(s) {
+                self.t_n[s] = 0.0;
+                self.status[s] = SlaveStatus::Outside;
+                continue;
+            }
+            let trial = self.lambda_n[s] + self.settings.eps_n * self.projections[s].g; // eq. 4.2
+            self.t_n[s] = trial.min(0.0);
+            self.status[s] = if trial < 0.0 { SlaveStatus::Active } else { SlaveStatus::Open };
+        }
+    }
+
+    /// Number of active slaves (after [`Self::update_states`]).
+    pub fn n_active(&self) -> usize {
+        self.status.iter().filter(|&&s| s == SlaveStatus::Active).count()
+    }
+
+    /// Number of slaves with a positive trial pressure at the last search (a cheap
+    /// count for progress lines, before the states are updated).
+    pub fn n_pressed(&self) -> usize {
+        (0..self.slaves.len()).filter(|&s| self.usable(s) && self.lambda_n[s] + self.settings.eps_n * self.projections[s].g < 0.0).count()
+    }
+
+    /// Largest penetration −g_N over the active slaves (0 if none).
+    pub fn max_penetration(&self) -> f64 {
+        (0..self.slaves.len()).filter(|&s| self.status[s] == SlaveStatus::Active).map(|s| -self.projections[s].g).fold(0.0, f64::max)
+    }
+
+    /// Whether another Uzawa update is due (augmented Lagrangian, penetration above
+    /// the tolerance, updates left).
+    pub fn needs_augmentation(&self) -> bool {
+        self.settings.enforcement == Enforcement::AugmentedLagrangian
+            && self.max_penetration() > self.settings.penetration_tolerance
+            && self.augmentations < self.settings.max_augmentations
+    }
+
+    /// Uzawa update λ_N ← t_N = min(0, λ_N + ε_N g_N) (sec. 4).
+    pub fn augment(&mut self) {
+        self.lambda_n.copy_from_slice(&self.t_n);
+        self.augmentations += 1;
+    }
+
+    /// Total force the master exerts on the slave body: Σ −t_N A_s n̄.
+    pub fn total_force(&self) -> Vec3 {
+        (0..self.slaves.len()).filter(|&s| self.status[s] == SlaveStatus::Active).map(|s| self.points[s].n_bar * (-self.t_n[s] * self.areas[s])).sum()
+    }
+
+    /// The increment converged: keep its multipliers.
+    pub fn commit(&mut self) {
+        self.lambda_committed.copy_from_slice(&self.lambda_n);
+        self.augmentations = 0;
+    }
+
+    /// The increment failed: back to the last converged multipliers.
+    pub fn restore(&mut self) {
+        self.lambda_n.copy_from_slice(&self.lambda_committed);
+        self.augmentations = 0;
+    }
+
+    /// Restart: set the multipliers of the last converged increment.
+    pub fn set_committed(&mut self, lambda_n: &[f64]) {
+        self.lambda_committed.copy_from_slice(lambda_n);
+        self.lambda_n.copy_from_slice(lambda_n);
+    }
+}

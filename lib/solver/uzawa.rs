@@ -1,0 +1,41 @@
+//! The augmented Lagrangian's outer loop (paper sec. 4; Simo & Laursen 1992): Newton
+//! converges with the multipliers λ_N fixed, then every augmented-Lagrangian pair
+//! whose largest penetration is above its tolerance updates
+//! ```text
+//! λ_N ← t_N = min(0, λ_N + ε_N g_N)                                (Uzawa, eq. 4.2)
+//! ```
+//! and Newton solves again from the converged state, until no pair needs an update
+//! or a pair has used its `max_augmentations` (then the increment is accepted and
+//! its summary says the penetration did not converge). Penalty pairs keep λ_N = 0.
+
+use super::newton::{Converged, IncrementFailure, Newton};
+use crate::format::scres::IterationLog;
+
+/// Newton plus Uzawa updates at load factor `lambda`; `u` is updated in place.
+/// `note` receives one line per update.
+pub fn solve_augmented(newton: &mut Newton, lambda: f64, u: &mut [f64], on_iteration: &mut dyn FnMut(&IterationLog), note: &mut dyn FnMut(&str)) -> Result<Converged, IncrementFailure> {
+    let mut iterations = Vec::new();
+    loop {
+        let conv = newton.solve_increment(lambda, u, on_iteration)?;
+        iterations.extend(conv.iterations);
+        let mut due = false;
+        for pair in &mut newton.contact {
+            pair.update_states();
+            if pair.needs_augmentation() {
+                note(&format!(
+                    "pair '{}': largest penetration {:.3e} > tolerance {:.3e}, {} active nodes: augmentation {} (λ_N ← t_N)",
+                    pair.name,
+                    pair.max_penetration(),
+                    pair.settings.penetration_tolerance,
+                    pair.n_active(),
+                    pair.augmentations + 1
+                ));
+                pair.augment();
+                due = true;
+            }
+        }
+        if !due {
+            return Ok(Converged { iterations });
+        }
+    }
+}
