@@ -119,6 +119,8 @@ pub struct PairSolver {
     capture: f64,
     /// See [`NormalLaw::touch`].
     touch: f64,
+    /// Largest tangential overhang beyond the patch edge still in contact.
+    edge_tolerance: f64,
     /// Uzawa updates made in the current increment.
     pub augmentations: u32,
 }
@@ -157,6 +159,7 @@ impl PairSolver {
             h_master,
             capture: 0.5 * h_master,
             touch: 1e-8 * h_master,
+            edge_tolerance: 1e-3 * h_master,
             augmentations: 0,
         })
     }
@@ -176,16 +179,29 @@ impl PairSolver {
             .with_min_len(64)
             .for_each(|((proj, sp), xs)| {
                 *proj = projector.project(xs);
-                if proj.inside && proj.converged {
+                if proj.converged {
                     *sp = projector.evaluate(proj.xi);
                 }
             });
         Ok(())
     }
 
+    /// The slave has a foot point on the patch: inside, or beyond an edge by less
+    /// than the edge tolerance (the overhang measured tangentially, 1e-3 of the
+    /// master's mean edge: a slave edge flush with the master edge must not flicker
+    /// in and out of contact by round-off or by a lateral strain difference).
     fn usable(&self, s: usize) -> bool {
         let p = &self.projections[s];
-        p.inside && p.converged && self.points[s].n_bar.iter().all(|v| v.is_finite())
+        let sp = &self.points[s];
+        if !(p.converged && sp.n_bar.iter().all(|v| v.is_finite())) {
+            return false;
+        }
+        if p.inside {
+            return true;
+        }
+        let d = self.x_slave[s] - p.x_bar;
+        let overhang = d - sp.n_bar * d.dot(&sp.n_bar);
+        overhang.norm() <= self.edge_tolerance
     }
 
     /// Appends the node group of every slave that needs a contact element now, and

@@ -92,3 +92,35 @@ pub fn add_node_set(mesh: &mut Mesh, name: &str, pred: impl Fn(&[f64; 3]) -> boo
     assert!(!nodes.is_empty(), "node set {name} is empty");
     mesh.node_sets.push(NodeSet { name: name.into(), physical_tag: 0, dim: 0, nodes });
 }
+
+/// Two meshes as one with two bodies: `b` shifted by `shift`. Bodies are named
+/// `name_a`, `name_b`; every set of each is prefixed (`lower_z1`, `upper_z0`, …).
+pub fn two_bodies(name_a: &str, a: &Mesh, name_b: &str, b: &Mesh, shift: [f64; 3]) -> Mesh {
+    let na = a.nodes.len() as u32;
+    let ea = a.hexes.len() as u32;
+    let mut m = Mesh {
+        nodes: a.nodes.clone(),
+        hexes: a.hexes.clone(),
+        hex_body: vec![0; a.hexes.len()],
+        bodies: vec![Body { name: name_a.into(), physical_tag: 1 }, Body { name: name_b.into(), physical_tag: 2 }],
+        node_sets: Vec::new(),
+        face_sets: Vec::new(),
+        node_tags: Vec::new(),
+        element_tags: Vec::new(),
+    };
+    m.nodes.extend(b.nodes.iter().map(|p| [p[0] + shift[0], p[1] + shift[1], p[2] + shift[2]]));
+    m.hexes.extend(b.hexes.iter().map(|h| h.map(|n| n + na)));
+    m.hex_body.extend(std::iter::repeat_n(1, b.hexes.len()));
+    for (prefix, src, dn, de) in [(name_a, a, 0, 0), (name_b, b, na, ea)] {
+        for s in &src.node_sets {
+            m.node_sets.push(NodeSet { name: format!("{prefix}_{}", s.name), physical_tag: 0, dim: s.dim, nodes: s.nodes.iter().map(|n| n + dn).collect() });
+        }
+        for s in &src.face_sets {
+            let faces = s.faces.iter().map(|f| HexFace { element: f.element + de, local: f.local }).collect();
+            m.face_sets.push(FaceSet { name: format!("{prefix}_{}", s.name), physical_tag: 0, faces, quad_tags: s.quad_tags.clone() });
+        }
+    }
+    m.node_tags = (1..=m.nodes.len() as u64).collect();
+    m.element_tags = (1..=m.hexes.len() as u64).collect();
+    m
+}

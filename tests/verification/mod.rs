@@ -1,1 +1,2 @@
 mod solid;
+mod contact;

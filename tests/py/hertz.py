@@ -1,0 +1,138 @@
+"""Plane-strain Hertz check of a solved pipelines/hertz.yaml (cylinder on a flat block).
+
+usage: hertz.py RESULTS.pvd|RESULTS.vtu [--scres FILE] [--csv FILE] [--load-set cyl_load]
+                [--R 8] [--E1 200 --nu1 0.3] [--E2 2e5 --nu2 0.3]
+
+Reads the last increment's .vtu (of the .pvd, or the .vtu given), the reaction of the
+loaded set from the .scres (default: the results' stem + .scres, dumped with
+`sc-export --format yaml`; sc-export from $SC_EXPORT or PATH) and the convergence CSV
+(default: <stem>.convergence.csv). Prints one JSON line.
+
+Definitions (the mesh: half cylinder x >= 0, one element layer in z, thickness t):
+- P = 2 |R_y(load set)| / t, the load per unit length of the FULL cylinder (the
+  symmetry half carries half of it). P_contact: the same from the contact pair's force.
+- E*: 1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2 (cylinder and block).
+- Closed form (Johnson, Contact Mechanics, 5.3) for the measured P:
+  b_hertz = sqrt(4 P R / (pi E*)), p0_hertz = 2 P / (pi b_hertz).
+- Contact line: the slave nodes (contact_status > -2) on the face z = 0, ordered by x;
+  positions are CURRENT x = X + u_x (x_ref: reference). Active: contact_pressure > 0.
+- p0_fe = max contact_pressure (the node on the symmetry plane).
+- Half-width: the pressure is nodal, so the edge lies between the last active node
+  (x_lo) and the first open node (x_hi); b_fe = (x_lo + x_hi)/2, bracket +-(x_hi - x_lo)/2
+  (an O(h) measure). Secondary: b_fit, p0_fit from a least-squares fit of the Hertz
+  ellipse p^2 = p0^2 (1 - x^2/b^2) (linear in x^2) to the active nodes.
+- h_slave: the slave (cylinder) node spacing at x = 0 (arc length of its first
+  element); h_master: the master (block_top) element length at x = 0.
+- newton: Newton corrections (linear solves) summed over increments, from the CSV;
+  augmentations: augmentation passes summed over increments.
+"""
+import argparse
+import json
+import math
+import os
+import sys
+
+import meshio
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import scresults as sr  # noqa: E402
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("results")
+    ap.add_argument("--scres")
+    ap.add_argument("--csv")
+    ap.add_argument("--load-set", default="cyl_load")
+    ap.add_argument("--master-set", default="block_top")
+    ap.add_argument("--R", type=float, default=8.0)
+    ap.add_argument("--E1", type=float, default=200.0)
+    ap.add_argument("--nu1", type=float, default=0.3)
+    ap.add_argument("--E2", type=float, default=2.0e5)
+    ap.add_argument("--nu2", type=float, default=0.3)
+    a = ap.parse_args()
+
+    vtu = sr.last_vtu(a.results)
+    scres = a.scres or sr.default_scres(a.results)
+    csv_path = a.csv or sr.default_csv(scres)
+    m = meshio.read(vtu)
+    X = np.asarray(m.points)
+    u = np.asarray(m.point_data["displacement"])
+    x = X + u
+    status = np.asarray(m.point_data["contact_status"])
+    p = np.asarray(m.point_data["contact_pressure"])
+    t = X[:, 2].max() - X[:, 2].min()
+    z0 = X[:, 2].min()
+
+    slave = np.where((status > -2) & np.isclose(X[:, 2], z0))[0]
+    slave = slave[np.argsort(X[slave, 0])]
+    other = np.where((status > -2) & ~np.isclose(X[:, 2], z0))[0]
+    other = other[np.argsort(X[other, 0])]
+    z_mismatch = float(np.abs(p[slave] - p[other]).max()) if len(other) == len(slave) else None
+
+    ps, xs, xr = p[slave], x[slave, 0], X[slave, 0]
+    active = ps > 0
+    if not active.any():
+        raise SystemExit("no active slave node")
+    n_act = int(np.argmax(~active)) if (~active).any() else len(ps)
+    if not active[:n_act].all() or active[n_act:].any():
+        print("warning: active set is not contiguous from x = 0", file=sys.stderr)
+    last, first_open = n_act - 1, n_act
+    x_lo = xs[last]
+    x_hi = xs[first_open] if first_open < len(xs) else float("nan")
+    b_fe = 0.5 * (x_lo + x_hi)
+    b_ref = 0.5 * (xr[last] + xr[first_open]) if first_open < len(xs) else float("nan")
+    p0_fe = float(ps.max())
+
+    # Hertz ellipse fit: p^2 = A - B x^2 over the active nodes
+    A = np.vstack([np.ones(n_act), -xs[:n_act] ** 2]).T
+    (c0, c1), *_ = np.linalg.lstsq(A, ps[:n_act] ** 2, rcond=None)
+    p0_fit = math.sqrt(c0) if c0 > 0 else float("nan")
+    b_fit = math.sqrt(c0 / c1) if c0 > 0 and c1 > 0 else float("nan")
+
+    incs = sr.scres_summary(scres)
+    inc = incs[-1]
+    ry = sr.reaction(inc, a.load_set)[1]
+    P = 2.0 * abs(ry) / t
+    pair = sr.pair_summary(inc)
+    P_contact = 2.0 * abs(float(pair["force"][1])) / t
+
+    Estar = 1.0 / ((1 - a.nu1 ** 2) / a.E1 + (1 - a.nu2 ** 2) / a.E2)
+    b_h = math.sqrt(4.0 * P * a.R / (math.pi * Estar))
+    p0_h = 2.0 * P / (math.pi * b_h)
+
+    h_slave = float(np.linalg.norm(X[slave[1]] - X[slave[0]]))
+    master = np.where((np.asarray(m.point_data["set:" + a.master_set]) > 0)
+                      & np.isclose(X[:, 2], z0))[0] if "set:" + a.master_set in m.point_data else []
+    h_master = float(np.sort(X[master, 0])[1] - np.sort(X[master, 0])[0]) if len(master) > 1 else None
+
+    conv = sr.convergence(csv_path) if os.path.exists(csv_path) else {}
+    out = {
+        "vtu": vtu,
+        "nodes": int(len(X)),
+        "increments": len(incs),
+        "h_slave": round(h_slave, 5),
+        "h_master": None if h_master is None else round(h_master, 5),
+        "E_star": round(Estar, 3),
+        "P": P, "P_contact": P_contact,
+        "b_fe": b_fe, "b_bracket": [float(x_lo), float(x_hi)], "b_fe_reference_x": float(b_ref),
+        "b_hertz": b_h, "b_err": b_fe / b_h - 1.0,
+        "p0_fe": p0_fe, "p0_hertz": p0_h, "p0_err": p0_fe / p0_h - 1.0,
+        "b_fit": b_fit, "p0_fit": p0_fit,
+        "b_fit_err": b_fit / b_h - 1.0, "p0_fit_err": p0_fit / p0_h - 1.0,
+        "active_nodes_line": n_act,
+        "pressure_z0_z1_mismatch": z_mismatch,
+        "max_penetration": float(pair["max_penetration"]),
+        "newton": sum(c["corrections"] for c in conv.values()) if conv else None,
+        "newton_per_increment": [c["corrections"] for c in conv.values()] if conv else None,
+        "augmentations": sum(c["augmentations"] for c in conv.values()) if conv else None,
+        "cutbacks": sum(c["attempts"] - 1 for c in conv.values()) if conv else None,
+        "solver_seconds": round(sum(sum(v for k, v in c.items() if k.startswith("seconds_"))
+                                    for c in conv.values()), 3) if conv else None,
+    }
+    print(json.dumps(out))
+
+
+if __name__ == "__main__":
+    main()
