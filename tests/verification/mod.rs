@@ -1,2 +1,3 @@
 mod solid;
 mod contact;
+mod parisch;
