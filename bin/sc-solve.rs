@@ -1,4 +1,4 @@
-//! sc-solve: finite-strain static solve of a hex8 mesh.
+//! sc-solve: finite-strain static solve of a hex8 mesh, with frictionless contact.
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -7,31 +7,45 @@ use splinecontact::format::setup::SolveSetup;
 use splinecontact::solver::log::Verbosity;
 use splinecontact::stages::solve;
 
-/// Solve a finite-strain static problem on a .scmesh: neo-Hookean (Ciarlet–Simo or
-/// deviatoric/volumetric) or linear elastic bodies of 8-node hexahedra, load
+/// Solve a finite-strain static problem on a .scmesh, or a contact problem on the
+/// .sccontact written by sc-tag: neo-Hookean (Ciarlet–Simo or deviatoric/volumetric)
+/// or linear elastic bodies of 8-node hexahedra, node-to-surface frictionless contact
+/// against a B-spline or facet master (penalty or augmented Lagrangian), load
 /// increments with Newton–Raphson, cut back when an increment fails.
 ///
 /// The setup YAML gives a material per body, constraints and loads on the mesh's
-/// named sets, the increments and the Newton tolerances (every key: docs/pipelines.md):
+/// named sets, the contact settings per pair, the increments and the Newton
+/// tolerances (every key: docs/pipelines.md):
 ///
 ///   materials:   [{body: block, model: neo_hookean, E: 1.0e4, nu: 0.3}]
 ///   constraints: [{set: base, fix: [x, y, z]}, {set: top, displacement: {z: -1.0}}]
 ///   loads:       [{set: tip, force: [0, 0, -10]}, {face_set: top, pressure: 2.0}]
+///   contact:     [{pair: contact, eps_n: 1.0e5, enforcement: augmented_lagrangian,
+///                  penetration_tolerance: 1.0e-4, max_augmentations: 20}]
 ///   increments:  {count: 10, max_cutbacks: 5}
 ///   newton:      {max_iterations: 25, residual_tolerance: 1.0e-8, energy_tolerance: 1.0e-12}
 ///
+/// eps_n is a pressure per unit penetration (times each slave node's tributary area).
+/// A body held only by contact must start touching its master or be supported, and
+/// its rigid in-plane modes need supports (frictionless contact carries no shear).
+///
 /// The results file (.scres) is rewritten after every converged increment, so a run
-/// that stops keeps everything it converged. The convergence history goes to a CSV
-/// (default: beside the results, <name>.convergence.csv). Exit codes: 0 done, 2 bad
+/// that stops keeps everything it converged, with the contact state (gap, pressure,
+/// multiplier, active flag per slave node; force and augmentations per pair). The
+/// convergence history goes to a CSV (default: beside the results,
+/// <name>.convergence.csv): residual, energy, active contact nodes and the time of
+/// contact search, assembly, factorization and solve per Newton iteration. Exit codes: 0 done, 2 bad
 /// input, 3 stopped without convergence (converged increments kept), 1 I/O.
 ///
 /// Example:
 ///   sc-solve block.scmesh --setup solve.yaml -o block.scres
 ///   sc-export block.scres -o block.pvd          # then: paraview block.pvd
+///   sc-tag two.scmesh --pair contact:top_slave:bottom_master:bspline:3:3 -o two.sccontact
+///   sc-solve two.sccontact --setup contact.yaml -o two.scres
 #[derive(Parser)]
 #[command(version, about, long_about, verbatim_doc_comment)]
 struct Args {
-    /// Input mesh (.scmesh), or - for standard input.
+    /// Input mesh (.scmesh) or contact model (.sccontact), or - for standard input.
     input: PathBuf,
     /// Solve setup (YAML).
     #[arg(short, long)]

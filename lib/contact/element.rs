@@ -370,6 +370,43 @@ mod tests {
         assert!((f_s - sp.n_bar * 20.0).norm() < 1e-9);
     }
 
+    /// A touching node (trial within ε_N·touch of zero) carries no force but the
+    /// closed-branch stiffness ε_N A_s N Nᵀ; a node beyond the touch band nothing.
+    #[test]
+    fn touching_node_has_penalty_stiffness_only() {
+        let patch = BSplinePatch::new(6, 5, 3, 3).unwrap();
+        let x = curved_net(6, 5);
+        let (sp, _) = MasterSurface::BSpline(&patch).evaluate_local(&x, [0.4, 0.6]);
+        let law = NormalLaw { lambda_n: 0.0, eps_n: 1e3, area: 2.0, touch: 1e-6 };
+        let (mut r, mut k) = (DVector::zeros(0), DMatrix::zeros(0, 0));
+        let st = normal_contact(&(sp.x_bar + sp.n_bar * 5e-7), &sp, &law, &mut r, &mut k).unwrap();
+        assert!(!st.active && st.t_n == 0.0);
+        assert!(r.iter().all(|&v| v == 0.0));
+        // K = ε A N Nᵀ: K_ss = ε A n̄ n̄ᵀ
+        for i in 0..3 {
+            for j in 0..3 {
+                assert!((k[(i, j)] - 2e3 * sp.n_bar[i] * sp.n_bar[j]).abs() < 1e-9);
+            }
+        }
+        let st = normal_contact(&(sp.x_bar + sp.n_bar * 2e-6), &sp, &law, &mut r, &mut k).unwrap();
+        assert!(!st.active && k.iter().all(|&v| v == 0.0));
+    }
+
+    /// A slave at the centre of curvature of the master: a typed error, not a panic.
+    #[test]
+    fn focal_point_is_an_error() {
+        let patch = BSplinePatch::new(7, 6, 3, 3).unwrap();
+        let x = curved_net(7, 6);
+        let (mut sp, _) = MasterSurface::BSpline(&patch).evaluate_local(&x, [0.43, 0.57]);
+        // make ā_αβ − g b̄_αβ singular at g = −1: b̄ = −ā
+        sp.b_ab = -sp.a_ab;
+        let law = NormalLaw { lambda_n: 0.0, eps_n: 1e3, area: 1.0, touch: 0.0 };
+        let (mut r, mut k) = (DVector::zeros(0), DMatrix::zeros(0, 0));
+        let e = normal_contact(&(sp.x_bar - sp.n_bar), &sp, &law, &mut r, &mut k).unwrap_err();
+        assert!(matches!(e, ContactElementError::FocalPoint { .. }), "{e}");
+        assert!(e.to_string().contains("centre of curvature"));
+    }
+
     /// The element's ξ̄ input agrees with the production projector on the patch.
     #[test]
     fn projector_gives_same_foot_point() {

@@ -86,6 +86,9 @@ pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, 
     };
     let outputs = Outputs { results: output, csv };
     let summary = increments::solve(&mut newton, &factors, setup.increments.max_cutbacks, &mut results, &outputs, &mut log);
+    if !newton.contact.is_empty() {
+        log.line(&format!("contact: the sparsity pattern was rebuilt {} times as contact elements changed", newton.pattern_rebuilds));
+    }
     log.finish();
     let summary = summary?;
     Ok(SolveReport { increments: summary.increments, iterations: summary.iterations, cutbacks: summary.cutbacks, seconds: start.elapsed().as_secs_f64() })
