@@ -141,6 +141,18 @@ impl<'p> Newton<'p> {
         Ok(())
     }
 
+    /// The full residual R(u) and the free-dof tangent K_ff at `u` (contact search
+    /// included), for checks against finite differences: `(residual, col_ptr,
+    /// row_idx, values)`, K_ff in compressed sparse columns over the free dofs.
+    pub fn residual_tangent_at(&mut self, u: &[f64], lambda: f64) -> Result<(Vec<f64>, Vec<usize>, Vec<usize>, Vec<f64>), IncrementFailure> {
+        self.contact_search(u, 0)?;
+        self.assemble(u, lambda).map_err(|f| match f {
+            AssemblyFailure::Hex(element, error) => IncrementFailure::Element { iteration: 0, element, error },
+            AssemblyFailure::Contact(pair, s, error) => IncrementFailure::Contact { iteration: 0, pair: self.contact[pair].name.clone(), node_tag: self.contact[pair].slaves[s] as u64, error },
+        })?;
+        Ok((self.residual.clone(), self.pattern.col_ptr().to_vec(), self.pattern.row_idx().to_vec(), self.assembly.values().to_vec()))
+    }
+
     /// Slave nodes pressed into the master at the last search, over all pairs.
     pub fn n_contact_pressed(&self) -> usize {
         self.contact.iter().map(|c| c.n_pressed()).sum()
