@@ -3,8 +3,12 @@
 usage: check_pvd.py RESULTS.pvd
 Parses the collection, reads every .vtu it lists with meshio and asserts the fields
 ParaView users rely on: point data displacement (n,3), stress (n,9), von_mises,
-principal_max >= principal_min; cell data body and stress. Prints one JSON line with
-the number of steps, the time values and max |u| of the last step per component.
+principal_max >= principal_min; cell data body and stress. When the results carry
+contact (point data contact_status), every step must have the four contact fields,
+pressure >= 0, pressure only where status = 1, status in {-2, -1, 0, 1}. Prints one
+JSON line with the number of steps, the time values and max |u| of the last step per
+component, and for contact the last step's slave pressures (status >= -1), active
+count and min/max gap.
 """
 import json
 import os
@@ -24,6 +28,7 @@ def main():
     times = [t for t, _ in entries]
     assert times == sorted(times), f"time steps not increasing: {times}"
     last = None
+    contact = None
     for t, f in entries:
         m = meshio.read(os.path.join(os.path.dirname(pvd), f))
         n = len(m.points)
@@ -40,7 +45,23 @@ def main():
         if t == 0.0:
             assert np.all(u == 0.0), "step 0 must be the undeformed state"
         last = u
-    print(json.dumps({"steps": len(entries), "times": times, "max_abs_u": np.abs(last).max(axis=0).tolist()}))
+        if "contact_status" in m.point_data or contact is not None:
+            fields = {k: np.asarray(m.point_data[k]).ravel() for k in ("contact_pressure", "contact_gap", "contact_lambda_n", "contact_status")}
+            st, p = fields["contact_status"], fields["contact_pressure"]
+            assert set(np.unique(st)) <= {-2.0, -1.0, 0.0, 1.0}, f"{f}: status values {np.unique(st)}"
+            assert np.all(p >= 0.0), f"{f}: negative contact pressure"
+            assert np.all(p[st != 1.0] == 0.0), f"{f}: pressure on a node that is not active"
+            slave = st >= -1.0
+            contact = {
+                "slave_pressures": p[slave].tolist(),
+                "active": int(np.sum(st == 1.0)),
+                "gap_min": float(np.nanmin(fields["contact_gap"][slave])) if t > 0 else None,
+                "gap_max": float(np.nanmax(fields["contact_gap"][slave])) if t > 0 else None,
+            }
+    out = {"steps": len(entries), "times": times, "max_abs_u": np.abs(last).max(axis=0).tolist()}
+    if contact is not None:
+        out["contact"] = contact
+    print(json.dumps(out))
 
 
 if __name__ == "__main__":

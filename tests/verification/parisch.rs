@@ -9,7 +9,7 @@ use splinecontact::format::setup::{Enforcement, ModelName, SolveSetup};
 use splinecontact::format::msh;
 
 use super::contact::{pair, run_contact};
-use crate::common::{repo, run, stderr, tempdir};
+use crate::common::{python_script, repo, run, stderr, tempdir};
 
 /// CalculiX, penalty K = 1e5: load-node u_z (7 significant digits in its .dat).
 const CCX_UZ_PENALTY: f64 = -5.028827e-2;
@@ -72,6 +72,16 @@ fn parisch_pipeline_matches_calculix() {
         assert!(f.iter().all(|v| v.abs() < 1e-6 * F), "{set}: {f:?}");
     }
     assert_eq!(inc.info.contact[0].active, 9);
+    // what ParaView shows: the contact fields on the slave nodes (read by meshio)
+    let o = python_script("check_pvd.py", &[&dir.path().join("pipelines/out/parisch.pvd")]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // JSON is YAML
+    let j: serde_yaml::Value = serde_yaml::from_slice(&o.stdout).unwrap();
+    assert_eq!(j["contact"]["active"].as_u64(), Some(9));
+    let p: Vec<f64> = j["contact"]["slave_pressures"].as_sequence().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+    // CalculiX: corners 4996.861, mid-edges 5000.645, centre 5001.694 (area convention: +6e-6 … +1e-5)
+    assert_eq!(p.len(), 9);
+    assert!(p.iter().all(|&v| (v - 5000.0).abs() < 5.0), "{p:?}");
 }
 
 /// Like for like with CalculiX: facet master, the deviatoric/volumetric neo-Hookean.
