@@ -112,3 +112,27 @@ fn pipeline_unknown_key() {
 fn pipeline_wrong_type() {
     pipeline_fails("version: 1\nstages:\n  - gmsh: {geo: a.geo, output: out.scmesh, binary: 3}\n", &["p.yaml", "line 3"]);
 }
+
+/// A contact setup that does not fit the contact model: each mistake is named with
+/// the setup file, exit code 2, and no results file is written.
+#[test]
+fn contact_setup_mistakes() {
+    let dir = tempdir();
+    std::fs::copy(repo().join("meshes/parisch.msh"), dir.path().join("p.msh")).unwrap();
+    assert!(run("sc-import", &["p.msh", "-o", "p.scmesh"], dir.path()).status.success());
+    let o = run("sc-tag", &["p.scmesh", "--pair", "contact:upper_bottom:lower_top", "-o", "p.sccontact"], dir.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let base = "materials:\n  - {body: upper, model: neo_hookean, E: 1.0e9, nu: 0.3}\n  - {body: lower, model: neo_hookean, E: 1.0e10, nu: 0.3}\nconstraints:\n  - {set: lower_base, fix: [x, y, z]}\n";
+    let cases: [(&str, &str, &[&str]); 5] = [
+        ("", "p.sccontact", &["bad.yaml", "contact pair 'contact' has no entry under `contact`"]),
+        ("contact:\n  - {pair: contakt, eps_n: 1.0e5}\n", "p.sccontact", &["bad.yaml", "contact pair 'contakt' does not exist", "contact"]),
+        ("contact:\n  - {pair: contact, eps_n: -1.0}\n", "p.sccontact", &["bad.yaml", "eps_n must be a positive number"]),
+        ("contact:\n  - {pair: contact, eps_n: 1.0e5, penetration_tolerance: 1.0e-3, penetration_tolerance_relative: 1.0e-3}\n", "p.sccontact", &["bad.yaml", "not both"]),
+        ("contact:\n  - {pair: contact, eps_n: 1.0e5}\n", "p.scmesh", &["bad.yaml", "the input has no contact pairs", ".sccontact"]),
+    ];
+    for (contact, input, needles) in cases {
+        std::fs::write(dir.path().join("bad.yaml"), format!("{base}{contact}")).unwrap();
+        let o = run("sc-solve", &[input, "--setup", "bad.yaml", "-o", "r.scres"], dir.path());
+        assert_fails(&o, 2, needles, &dir.path().join("r.scres"));
+    }
+}
