@@ -6,9 +6,13 @@
 //! | [`net`]       | a master face set ordered into the a × b control net P_{i,j} (eq. 5.2), outward n̄ |
 //! | [`tributary`] | slave tributary areas A_s (eq. 6.1) |
 //! | [`element`]   | one slave node against the master: g_N, t_N, residual and tangent (eqs. 4.2–4.3, 6.2–6.5) |
+//! | [`friction`]  | Coulomb friction of one slave node: trial traction, return mapping (eqs. 4.5–4.9) |
+//! | [`dual`]      | forward-mode dual numbers, for the exact frictional tangent |
 //! | [`pair`]      | one pair during the solve: search, active set, Uzawa updates |
 
+pub mod dual;
 pub mod element;
+pub mod friction;
 pub mod net;
 pub mod pair;
 pub mod tributary;

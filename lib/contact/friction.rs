@@ -1,0 +1,346 @@
+//! Coulomb friction for one slave node against the master (paper eqs. 4.5–4.9), on
+//! top of the normal contact of [`super::element`].
+//!
+//! Convective description: the slave slides over the master by the change of its
+//! foot point ξ̄ (eq. 4.9: δg_T = δξ̄^α ā_α). With ξ̄_n the converged foot point of the
+//! previous increment and t_{Tα,n} its converged covariant tangential traction:
+//! ```text
+//! t_Tα^trial = t_Tα,n + ε_T ā_αβ (ξ̄^β − ξ̄_n^β)                        (4.7)
+//! Φ = ‖t_T^trial‖ − μ |t_N|,   ‖t‖ = (t_α ā^{αβ} t_β)^{1/2}              (4.8)
+//! t_Tα = t_Tα^trial                         stick (Φ ≤ 0)                 (4.6)
+//!      = μ |t_N| t_Tα^trial / ‖t_T^trial‖   slip  (Φ > 0)
+//! r    = A_s [ t_N ∂g_N/∂u + t_Tα ∂ξ̄^α/∂u ]                              (6.2)
+//! ∂ξ̄^α/∂u = D^{αβ} (T_β − g_N N_β),  D = (ā_αβ − g_N b̄_αβ)⁻¹            (4.10)
+//! ```
+//! (T_β, N_β as in [`super::element`]). `r` is the contribution to the internal
+//! force: the force on the slave, −r_s = −A_s t_Tα D^{αβ} ā_β, opposes the slip.
+//!
+//! **Tangent.** K = ∂r/∂u, non-symmetric in slip. Instead of transcribing the
+//! paper's eqs. 4.19–4.22 (whose printed indices are inconsistent), K is the exact
+//! derivative of `r` by forward-mode dual numbers: for every element dof j the
+//! inputs are seeded with their derivative along e_j — x_s, x_A, and ξ̄ through its
+//! first variation ∂ξ̄/∂u (eq. 4.10) — and the surface quantities with theirs
+//! (ā_α' = Q_{A,α} x_A' + ā_{α,β} ξ̄^β', ā_{α,β}' = Q_{A,αβ} x_A' + ā_{α,βγ} ξ̄^γ',
+//! Q_A' = Q_{A,α} ξ̄^α', Q_{A,α}' = Q_{A,αβ} ξ̄^β'). Evaluating `r` on these duals gives
+//! column j of K to round-off, including every metric, curvature and return-mapping
+//! term. Cost O(m²) for an element of m dofs, like the analytical form.
+
+use nalgebra::{DMatrix, DVector};
+
+use super::dual::{cross, d3, dot, inv2, scale, sub, Dual, D3};
+use super::element::{normal_contact, ContactElementError, NormalLaw};
+use crate::spline::{SurfacePoint, Vec3, MAX_NODES};
+
+/// Friction parameters and the history of one slave node.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FrictionLaw {
+    /// Coulomb coefficient μ.
+    pub mu: f64,
+    /// Tangential penalty ε_T (traction per unit slip).
+    pub eps_t: f64,
+    /// Converged foot point ξ̄_n of the previous increment.
+    pub xi_n: [f64; 2],
+    /// Converged covariant tangential traction t_{Tα,n} (zero if the node was not in contact).
+    pub t_t_n: [f64; 2],
+}
+
+/// Outcome of one frictional slave-node evaluation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FrictionState {
+    pub g_n: f64,
+    pub t_n: f64,
+    pub active: bool,
+    /// Covariant tangential traction t_Tα.
+    pub t_t: [f64; 2],
+    /// Tangential traction vector t_T = t_Tα ā^{αβ} ā_β (as a traction the slave exerts
+    /// on the master; the master pushes the slave with −t_T).
+    pub t_t_vector: Vec3,
+    /// Whether the return mapping slipped (Φ > 0).
+    pub slip: bool,
+}
+
+/// The element's dofs: `3(1 + n_c)` ≤ this.
+const MAX_DOFS: usize = 3 * (1 + MAX_NODES);
+
+/// Residual and tangent of one slave node with Coulomb friction; the inputs as for
+/// [`normal_contact`], plus the friction law. Inactive (open or touching) nodes are
+/// handed to [`normal_contact`] (no friction without pressure).
+pub fn frictional_contact(
+    xs: &Vec3,
+    sp: &SurfacePoint,
+    normal: &NormalLaw,
+    friction: &FrictionLaw,
+    r: &mut DVector<f64>,
+    k: &mut DMatrix<f64>,
+) -> Result<FrictionState, ContactElementError> {
+    let nc = sp.basis.len();
+    let m = 3 * (1 + nc);
+    let g0 = (xs - sp.x_bar).dot(&sp.n_bar);
+    if normal.lambda_n + normal.eps_n * g0 >= 0.0 || friction.mu == 0.0 && friction.eps_t == 0.0 {
+        let st = normal_contact(xs, sp, normal, r, k)?;
+        return Ok(FrictionState { g_n: st.g_n, t_n: st.t_n, active: st.active, t_t: [0.0; 2], t_t_vector: Vec3::zeros(), slip: false });
+    }
+    if r.len() != m {
+        *r = DVector::zeros(m);
+    }
+    if k.shape() != (m, m) {
+        *k = DMatrix::zeros(m, m);
+    }
+    // First variation of ξ̄ (eq. 4.10) in floats: w_β = T_β − g N_β, δξ̄ = D w.
+    let q = sp.basis.q();
+    let qa = sp.basis.q_alpha();
+    let qab = sp.basis.q_alpha_beta();
+    let d0 = (sp.a_ab - sp.b_ab * g0).try_inverse().ok_or(ContactElementError::FocalPoint { g_n: g0 })?;
+    let mut w = [[0.0; MAX_DOFS]; 2];
+    for c in 0..3 {
+        for be in 0..2 {
+            w[be][c] = sp.a_alpha[be][c];
+            for a in 0..nc {
+                w[be][3 * (1 + a) + c] = -q[a] * sp.a_alpha[be][c] + g0 * qa[a][be] * sp.n_bar[c];
+            }
+        }
+    }
+    let mut state = None;
+    for j in 0..=m {
+        // j < m: seed direction e_j; j = m: values only (the residual and the state)
+        let (slave_dir, master_dir) = if j < 3 {
+            (Some(j), None)
+        } else if j < m {
+            (None, Some(((j - 3) / 3, j % 3)))
+        } else {
+            (None, None)
+        };
+        let dxi: [f64; 2] = if j < m { [d0[(0, 0)] * w[0][j] + d0[(0, 1)] * w[1][j], d0[(1, 0)] * w[0][j] + d0[(1, 1)] * w[1][j]] } else { [0.0; 2] };
+        // seeded surface quantities
+        let e = |c: usize| {
+            let mut v = Vec3::zeros();
+            v[c] = 1.0;
+            v
+        };
+        let dxs = slave_dir.map_or(Vec3::zeros(), e);
+        let (qd, qad): (Vec<Dual>, Vec<[Dual; 2]>) = (0..nc)
+            .map(|a| {
+                let qv = Dual::new(q[a], qa[a][0] * dxi[0] + qa[a][1] * dxi[1]);
+                let qav = [0, 1].map(|al| Dual::new(qa[a][al], qab[a][al][0] * dxi[0] + qab[a][al][1] * dxi[1]));
+                (qv, qav)
+            })
+            .unzip();
+        let mut dx_bar = sp.a_alpha[0] * dxi[0] + sp.a_alpha[1] * dxi[1];
+        let mut da = [sp.a_alpha_beta[0][0] * dxi[0] + sp.a_alpha_beta[0][1] * dxi[1], sp.a_alpha_beta[1][0] * dxi[0] + sp.a_alpha_beta[1][1] * dxi[1]];
+        let mut dab = [[Vec3::zeros(); 2]; 2];
+        for al in 0..2 {
+            for be in 0..2 {
+                dab[al][be] = sp.a_alpha_beta_gamma[al][be][0] * dxi[0] + sp.a_alpha_beta_gamma[al][be][1] * dxi[1];
+            }
+        }
+        if let Some((a, c)) = master_dir {
+            dx_bar[c] += q[a];
+            for al in 0..2 {
+                da[al][c] += qa[a][al];
+                for be in 0..2 {
+                    dab[al][be][c] += qab[a][al][be];
+                }
+            }
+        }
+        let x_s = d3(xs, &dxs);
+        let x_bar = d3(&sp.x_bar, &dx_bar);
+        let a_al = [d3(&sp.a_alpha[0], &da[0]), d3(&sp.a_alpha[1], &da[1])];
+        let a_ab_v = [[d3(&sp.a_alpha_beta[0][0], &dab[0][0]), d3(&sp.a_alpha_beta[0][1], &dab[0][1])], [d3(&sp.a_alpha_beta[1][0], &dab[1][0]), d3(&sp.a_alpha_beta[1][1], &dab[1][1])]];
+        // n̄, g_N, metric, curvature (eqs. 4.3, 4.11, 4.12)
+        let cr = cross(&a_al[0], &a_al[1]);
+        let n = scale(&cr, Dual::cst(1.0) / dot(&cr, &cr).sqrt());
+        let g = dot(&sub(&x_s, &x_bar), &n);
+        let met = [[dot(&a_al[0], &a_al[0]), dot(&a_al[0], &a_al[1])], [dot(&a_al[1], &a_al[0]), dot(&a_al[1], &a_al[1])]];
+        let met_inv = inv2(met).ok_or(ContactElementError::FocalPoint { g_n: g0 })?;
+        let b = [[dot(&a_ab_v[0][0], &n), dot(&a_ab_v[0][1], &n)], [dot(&a_ab_v[1][0], &n), dot(&a_ab_v[1][1], &n)]];
+        let mm = [[met[0][0] - g * b[0][0], met[0][1] - g * b[0][1]], [met[1][0] - g * b[1][0], met[1][1] - g * b[1][1]]];
+        let dm = inv2(mm).ok_or(ContactElementError::FocalPoint { g_n: g0 })?;
+        // normal law (eq. 4.2)
+        let t_n = Dual::cst(normal.lambda_n) + g * normal.eps_n;
+        // trial tangential traction and return mapping (eqs. 4.6–4.8)
+        let xi = [Dual::new(sp.xi[0], dxi[0]), Dual::new(sp.xi[1], dxi[1])];
+        let slip_xi = [xi[0] - Dual::cst(friction.xi_n[0]), xi[1] - Dual::cst(friction.xi_n[1])];
+        let tr = [0, 1].map(|al| Dual::cst(friction.t_t_n[al]) + (met[al][0] * slip_xi[0] + met[al][1] * slip_xi[1]) * friction.eps_t);
+        let norm2 = tr[0] * met_inv[0][0] * tr[0] + tr[0] * met_inv[0][1] * tr[1] + tr[1] * met_inv[1][0] * tr[0] + tr[1] * met_inv[1][1] * tr[1];
+        let limit = -t_n * friction.mu; // μ|t_N|, t_N < 0
+        let slip = norm2.v > 0.0 && norm2.v.sqrt() > limit.v;
+        let t_t = if slip {
+            let nrm = norm2.sqrt();
+            [tr[0] * limit / nrm, tr[1] * limit / nrm]
+        } else {
+            tr
+        };
+        // r = A (t_N N + t_Tα ∂ξ̄^α/∂u), assembled per node block
+        let area = normal.area;
+        let mut put = |i: usize, v: Dual| {
+            if j < m {
+                k[(i, j)] = v.d * area;
+            } else {
+                r[i] = v.v * area;
+            }
+        };
+        // slave block: N_s = n̄, ∂ξ̄^α/∂x_s = D^{αβ} ā_β
+        let dxi_s = [0, 1].map(|al| [0, 1, 2].map(|c| dm[al][0] * a_al[0][c] + dm[al][1] * a_al[1][c]));
+        for c in 0..3 {
+            put(c, t_n * n[c] + t_t[0] * dxi_s[0][c] + t_t[1] * dxi_s[1][c]);
+        }
+        for a in 0..nc {
+            // N_A = −Q_A n̄; w_β,A = −Q_A ā_β + g Q_{A,β} n̄; ∂ξ̄^α/∂x_A = D^{αβ} w_β,A
+            let wa: [D3; 2] = [0, 1].map(|be| [0, 1, 2].map(|c| -qd[a] * a_al[be][c] + g * qad[a][be] * n[c]));
+            for c in 0..3 {
+                let dxi_a = [dm[0][0] * wa[0][c] + dm[0][1] * wa[1][c], dm[1][0] * wa[0][c] + dm[1][1] * wa[1][c]];
+                put(3 * (1 + a) + c, -t_n * qd[a] * n[c] + t_t[0] * dxi_a[0] + t_t[1] * dxi_a[1]);
+            }
+        }
+        if j == m {
+            let tv: D3 = [0, 1, 2].map(|c| {
+                let up = [met_inv[0][0] * t_t[0] + met_inv[0][1] * t_t[1], met_inv[1][0] * t_t[0] + met_inv[1][1] * t_t[1]];
+                up[0] * a_al[0][c] + up[1] * a_al[1][c]
+            });
+            state = Some(FrictionState {
+                g_n: g.v,
+                t_n: t_n.v,
+                active: true,
+                t_t: [t_t[0].v, t_t[1].v],
+                t_t_vector: Vec3::new(tv[0].v, tv[1].v, tv[2].v),
+                slip,
+            });
+        }
+    }
+    Ok(state.expect("the value pass ran"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contact::element::MasterSurface;
+    use crate::fem::fd::{fd_jacobian, rel_err, FdStep};
+    use crate::spline::{BSplinePatch, FacetSurface, Mat2};
+
+    fn curved_net(na: usize, nb: usize) -> Vec<Vec3> {
+        let rad = 4.0;
+        let mut x = Vec::with_capacity(na * nb);
+        for j in 0..nb {
+            for i in 0..na {
+                let th = (i as f64 + 0.2 * j as f64) / rad;
+                let y = j as f64 + 0.15 * (i as f64 * 0.9).sin();
+                let w = 0.12 * (0.8 * y).sin();
+                x.push(Vec3::new((rad + w) * th.sin(), y, (rad + w) * th.cos() - rad));
+            }
+        }
+        x
+    }
+
+    fn reproject(surf: &MasterSurface, x_all: &[Vec3], xs: &Vec3, xi0: [f64; 2]) -> [f64; 2] {
+        let mut xi = xi0;
+        for _ in 0..50 {
+            let (sp, _) = surf.evaluate_local(x_all, xi);
+            let d = xs - sp.x_bar;
+            let f = nalgebra::Vector2::new(d.dot(&sp.a_alpha[0]), d.dot(&sp.a_alpha[1]));
+            let jac = Mat2::from_fn(|a, b| -sp.a_ab[(a, b)] + d.dot(&sp.a_alpha_beta[a][b]));
+            let step = -jac.try_inverse().unwrap() * f;
+            xi[0] += step[0];
+            xi[1] += step[1];
+            if step.norm() < 1e-17 {
+                break;
+            }
+        }
+        xi
+    }
+
+    /// K against central differences of r (slave re-projected at every perturbation)
+    /// in stick and in slip, facet and B-spline masters of orders 2–4, interior and
+    /// edge-adjacent spans; and with μ = ε_T = 0 the frictionless element's K.
+    #[test]
+    fn tangent_matches_finite_differences_in_stick_and_slip() {
+        let (na, nb) = (7, 6);
+        for order in [0usize, 2, 3, 4] {
+            let kk = order.max(2);
+            let (ma, mb) = ((na - kk + 1) as f64, (nb - kk + 1) as f64);
+            for xi0 in [[(((na - kk + 1) / 2) as f64 + 0.37) / ma, (((nb - kk + 1) / 2) as f64 + 0.37) / mb], [0.37 / ma, (mb - 1.0 + 0.37) / mb]] {
+                let (patch, facet);
+                let surf = if order == 0 {
+                    facet = FacetSurface::new(na, nb).unwrap();
+                    MasterSurface::Facet(&facet)
+                } else {
+                    patch = BSplinePatch::new(na, nb, order, order).unwrap();
+                    MasterSurface::BSpline(&patch)
+                };
+                let x_all = curved_net(na, nb);
+                let (sp0, xm0) = surf.evaluate_local(&x_all, xi0);
+                let nodes = sp0.basis.nodes().to_vec();
+                let nc = nodes.len();
+                let m = 3 * (1 + nc);
+                let xs0 = sp0.x_bar - sp0.n_bar * 1e-2;
+                let normal = NormalLaw { lambda_n: -1.0, eps_n: 100.0, area: 0.7, touch: 0.0 };
+                // slip of 0.02 in ξ: ε_T a Δξ ≈ 1e3·1·0.02·ns ≈ 20·ns ≫ μ|t_N| = 0.3·2 (slip);
+                // ε_T = 5 gives ≈ 0.1·ns < 0.6 (stick)
+                let back = [xi0[0] - 0.02 / (na as f64), xi0[1] + 0.01 / (nb as f64)];
+                for (eps_t, mu, want_slip) in [(1e3, 0.3, true), (5.0, 0.3, false), (0.0, 0.0, false)] {
+                    let fr = FrictionLaw { mu, eps_t, xi_n: back, t_t_n: [0.05, -0.02] };
+                    let (mut r, mut k) = (DVector::zeros(0), DMatrix::zeros(0, 0));
+                    let st = frictional_contact(&xs0, &sp0, &normal, &fr, &mut r, &mut k).unwrap();
+                    assert!(st.active);
+                    if mu > 0.0 {
+                        assert_eq!(st.slip, want_slip, "order {order} ε_T {eps_t}: {st:?}");
+                    } else {
+                        // no friction: the frictionless element, analytical K
+                        let (mut r2, mut k2) = (DVector::zeros(0), DMatrix::zeros(0, 0));
+                        normal_contact(&xs0, &sp0, &normal, &mut r2, &mut k2).unwrap();
+                        assert!((&r - &r2).norm() < 1e-12 * r2.norm() && (&k - &k2).norm() < 1e-10 * k2.norm(), "order {order}: dual K vs analytical K");
+                        continue;
+                    }
+                    let mut u = vec![0.0; m];
+                    for c in 0..3 {
+                        u[c] = xs0[c];
+                        for a in 0..nc {
+                            u[3 * (1 + a) + c] = xm0[a][c];
+                        }
+                    }
+                    let fd = fd_jacobian(
+                        |v, out| {
+                            let mut x = x_all.clone();
+                            for (a, &nd) in nodes.iter().enumerate() {
+                                x[nd] = Vec3::new(v[3 * (1 + a)], v[3 * (1 + a) + 1], v[3 * (1 + a) + 2]);
+                            }
+                            let xs = Vec3::new(v[0], v[1], v[2]);
+                            let xi = reproject(&surf, &x, &xs, xi0);
+                            let (sp, _) = surf.evaluate_local(&x, xi);
+                            assert_eq!(sp.basis.nodes(), &nodes[..], "perturbation left the span");
+                            let (mut rr, mut kk) = (DVector::zeros(0), DMatrix::zeros(0, 0));
+                            frictional_contact(&xs, &sp, &normal, &fr, &mut rr, &mut kk).unwrap();
+                            out.copy_from_slice(rr.as_slice());
+                        },
+                        &u,
+                        m,
+                        FdStep { rel_step: 1e-7, scale: 1.0 },
+                    );
+                    let e = rel_err(k.as_slice(), fd.as_slice());
+                    let asym = (&k - k.transpose()).norm() / k.norm();
+                    eprintln!("friction FD order {order} ξ0 {xi0:.3?} {}: rel err {e:.2e}, asymmetry {asym:.2e}", if want_slip { "slip" } else { "stick" });
+                    assert!(e < 1e-6, "order {order} slip {want_slip}: {e:e}");
+                }
+            }
+        }
+    }
+
+    /// The friction force on the slave opposes the slip and is capped at μ|t_N| A_s.
+    #[test]
+    fn friction_force_opposes_slip_and_is_capped() {
+        let patch = BSplinePatch::new(6, 6, 3, 3).unwrap();
+        // flat net, unit spacing: ā_1 = 5 e_x, ā_2 = 5 e_y (5 spans... parameter in [0,1])
+        let x: Vec<Vec3> = (0..36).map(|k| Vec3::new((k % 6) as f64, (k / 6) as f64, 0.0)).collect();
+        let (sp, _) = MasterSurface::BSpline(&patch).evaluate_local(&x, [0.5, 0.5]);
+        let xs = sp.x_bar - sp.n_bar * 0.01;
+        let normal = NormalLaw { lambda_n: 0.0, eps_n: 1e3, area: 2.0, touch: 0.0 };
+        // the slave has moved +x relative to where it stuck: ξ_n behind in ξ¹
+        let fr = FrictionLaw { mu: 0.3, eps_t: 1e6, xi_n: [0.49, 0.5], t_t_n: [0.0; 2] };
+        let (mut r, mut k) = (DVector::zeros(0), DMatrix::zeros(0, 0));
+        let st = frictional_contact(&xs, &sp, &normal, &fr, &mut r, &mut k).unwrap();
+        assert!(st.slip);
+        let f_s = -Vec3::new(r[0], r[1], r[2]);
+        // normal 10 × 2 = 20 along +z, friction 0.3 × 20 = 6 along −x
+        assert!((f_s - Vec3::new(-6.0, 0.0, 20.0)).norm() < 1e-9, "{f_s:?}");
+        assert!((st.t_t_vector.norm() - 3.0).abs() < 1e-9);
+    }
+}
