@@ -57,6 +57,8 @@ pub struct FrictionState {
     pub t_t_vector: Vec3,
     /// Whether the return mapping slipped (Φ > 0).
     pub slip: bool,
+    /// Force the master exerts on the slave node, −r_s (normal and tangential).
+    pub slave_force: Vec3,
 }
 
 /// The element's dofs: `3(1 + n_c)` ≤ this.
@@ -73,19 +75,42 @@ pub fn frictional_contact(
     r: &mut DVector<f64>,
     k: &mut DMatrix<f64>,
 ) -> Result<FrictionState, ContactElementError> {
+    evaluate(xs, sp, normal, friction, r, Some(k))
+}
+
+/// The state alone (t_N, t_Tα, stick/slip, the force on the slave), without the
+/// tangent: for the converged-state output.
+pub fn friction_state(xs: &Vec3, sp: &SurfacePoint, normal: &NormalLaw, friction: &FrictionLaw) -> Result<FrictionState, ContactElementError> {
+    let mut r = DVector::zeros(3 * (1 + sp.basis.len()));
+    evaluate(xs, sp, normal, friction, &mut r, None)
+}
+
+fn evaluate(
+    xs: &Vec3,
+    sp: &SurfacePoint,
+    normal: &NormalLaw,
+    friction: &FrictionLaw,
+    r: &mut DVector<f64>,
+    mut k: Option<&mut DMatrix<f64>>,
+) -> Result<FrictionState, ContactElementError> {
     let nc = sp.basis.len();
     let m = 3 * (1 + nc);
     let g0 = (xs - sp.x_bar).dot(&sp.n_bar);
     if normal.lambda_n + normal.eps_n * g0 >= 0.0 || friction.mu == 0.0 && friction.eps_t == 0.0 {
-        let st = normal_contact(xs, sp, normal, r, k)?;
-        return Ok(FrictionState { g_n: st.g_n, t_n: st.t_n, active: st.active, t_t: [0.0; 2], t_t_vector: Vec3::zeros(), slip: false });
+        let mut scratch = DMatrix::zeros(0, 0);
+        let st = normal_contact(xs, sp, normal, r, k.unwrap_or(&mut scratch))?;
+        let slave_force = -Vec3::new(r[0], r[1], r[2]);
+        return Ok(FrictionState { g_n: st.g_n, t_n: st.t_n, active: st.active, t_t: [0.0; 2], t_t_vector: Vec3::zeros(), slip: false, slave_force });
     }
     if r.len() != m {
         *r = DVector::zeros(m);
     }
-    if k.shape() != (m, m) {
-        *k = DMatrix::zeros(m, m);
+    if let Some(k) = k.as_deref_mut() {
+        if k.shape() != (m, m) {
+            *k = DMatrix::zeros(m, m);
+        }
     }
+    let first = if k.is_some() { 0 } else { m };
     // First variation of ξ̄ (eq. 4.10) in floats: w_β = T_β − g N_β, δξ̄ = D w.
     let q = sp.basis.q();
     let qa = sp.basis.q_alpha();
@@ -101,7 +126,7 @@ pub fn frictional_contact(
         }
     }
     let mut state = None;
-    for j in 0..=m {
+    for j in first..=m {
         // j < m: seed direction e_j; j = m: values only (the residual and the state)
         let (slave_dir, master_dir) = if j < 3 {
             (Some(j), None)
@@ -174,7 +199,9 @@ pub fn frictional_contact(
         let area = normal.area;
         let mut put = |i: usize, v: Dual| {
             if j < m {
-                k[(i, j)] = v.d * area;
+                if let Some(k) = k.as_deref_mut() {
+                    k[(i, j)] = v.d * area;
+                }
             } else {
                 r[i] = v.v * area;
             }
@@ -204,10 +231,13 @@ pub fn frictional_contact(
                 t_t: [t_t[0].v, t_t[1].v],
                 t_t_vector: Vec3::new(tv[0].v, tv[1].v, tv[2].v),
                 slip,
+                slave_force: Vec3::zeros(),
             });
         }
     }
-    Ok(state.expect("the value pass ran"))
+    let mut state = state.expect("the value pass ran");
+    state.slave_force = -Vec3::new(r[0], r[1], r[2]);
+    Ok(state)
 }
 
 #[cfg(test)]

@@ -19,7 +19,8 @@
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 
-use super::element::{normal_contact, ContactElementError, ContactState, NormalLaw};
+use super::element::{normal_contact, ContactElementError, NormalLaw};
+use super::friction::{friction_state, frictional_contact, FrictionLaw};
 use crate::format::sccontact::MasterKind;
 use crate::solver::problem::ContactDefinition;
 use crate::format::setup::Enforcement;
@@ -33,6 +34,15 @@ pub struct PairSettings {
     /// Largest accepted penetration (length), augmented Lagrangian.
     pub penetration_tolerance: f64,
     pub max_augmentations: u32,
+    /// Coulomb coefficient μ and tangential penalty ε_T (μ = 0: frictionless).
+    pub mu: f64,
+    pub eps_t: f64,
+}
+
+impl PairSettings {
+    pub fn frictional(&self) -> bool {
+        self.mu > 0.0
+    }
 }
 
 /// Where a slave node stands after the last search / state update.
@@ -123,6 +133,16 @@ pub struct PairSolver {
     edge_tolerance: f64,
     /// Uzawa updates made in the current increment.
     pub augmentations: u32,
+    /// Friction history (eq. 4.7): the converged foot point ξ̄_n and covariant
+    /// tangential traction t_{Tα,n} of the last increment (zero when not in contact).
+    xi_n: Vec<[f64; 2]>,
+    t_t_n: Vec<[f64; 2]>,
+    /// After [`Self::update_states`], frictional pairs: t_Tα, the traction vector,
+    /// slip (else stick), the force on the slave node.
+    pub t_t: Vec<[f64; 2]>,
+    pub t_t_vector: Vec<Vec3>,
+    pub slipping: Vec<bool>,
+    pub slave_force: Vec<Vec3>,
 }
 
 impl PairSolver {
@@ -161,6 +181,12 @@ impl PairSolver {
             touch: 1e-8 * h_master,
             edge_tolerance: 1e-3 * h_master,
             augmentations: 0,
+            xi_n: vec![[f64::NAN; 2]; n],
+            t_t_n: vec![[0.0; 2]; n],
+            t_t: vec![[0.0; 2]; n],
+            t_t_vector: vec![Vec3::zeros(); n],
+            slipping: vec![false; n],
+            slave_force: vec![Vec3::zeros(); n],
         })
     }
 
@@ -220,15 +246,34 @@ impl PairSolver {
         }
     }
 
-    /// The contact element of slave `s` (group nodes `[slave, control points]`).
-    pub fn element(&self, s: usize, r: &mut DVector<f64>, k: &mut DMatrix<f64>) -> Result<ContactState, ContactElementError> {
-        let law = NormalLaw { lambda_n: self.lambda_n[s], eps_n: self.settings.eps_n, area: self.areas[s], touch: self.touch };
-        normal_contact(&self.x_slave[s], &self.points[s], &law, r, k)
+    fn normal_law(&self, s: usize) -> NormalLaw {
+        NormalLaw { lambda_n: self.lambda_n[s], eps_n: self.settings.eps_n, area: self.areas[s], touch: self.touch }
     }
 
-    /// t_N and status of every slave at the last search.
-    pub fn update_states(&mut self) {
+    /// The friction law of slave `s`: its history, or (first contact ever) no
+    /// slip so far: ξ̄_n = the current foot point.
+    fn friction_law(&self, s: usize) -> FrictionLaw {
+        let xi_n = if self.xi_n[s][0].is_nan() { self.projections[s].xi } else { self.xi_n[s] };
+        FrictionLaw { mu: self.settings.mu, eps_t: self.settings.eps_t, xi_n, t_t_n: self.t_t_n[s] }
+    }
+
+    /// The contact element of slave `s` (group nodes `[slave, control points]`).
+    pub fn element(&self, s: usize, r: &mut DVector<f64>, k: &mut DMatrix<f64>) -> Result<(), ContactElementError> {
+        if self.settings.frictional() {
+            frictional_contact(&self.x_slave[s], &self.points[s], &self.normal_law(s), &self.friction_law(s), r, k).map(|_| ())
+        } else {
+            normal_contact(&self.x_slave[s], &self.points[s], &self.normal_law(s), r, k).map(|_| ())
+        }
+    }
+
+    /// t_N and status of every slave at the last search; for frictional pairs also
+    /// the tangential traction and stick/slip.
+    pub fn update_states(&mut self) -> Result<(), (u32, ContactElementError)> {
         for s in 0..self.slaves.len() {
+            self.t_t[s] = [0.0; 2];
+            self.t_t_vector[s] = Vec3::zeros();
+            self.slipping[s] = false;
+            self.slave_force[s] = Vec3::zeros();
             if !self.usable(s) {
                 self.t_n[s] = 0.0;
                 self.status[s] = SlaveStatus::Outside;
@@ -237,7 +282,45 @@ impl PairSolver {
             let trial = self.lambda_n[s] + self.settings.eps_n * self.projections[s].g; // eq. 4.2
             self.t_n[s] = trial.min(0.0);
             self.status[s] = if trial < 0.0 { SlaveStatus::Active } else { SlaveStatus::Open };
+            if trial < 0.0 {
+                self.slave_force[s] = self.points[s].n_bar * (-self.t_n[s] * self.areas[s]);
+                if self.settings.frictional() {
+                    let st = friction_state(&self.x_slave[s], &self.points[s], &self.normal_law(s), &self.friction_law(s)).map_err(|e| (self.slaves[s], e))?;
+                    self.t_t[s] = st.t_t;
+                    self.t_t_vector[s] = st.t_t_vector;
+                    self.slipping[s] = st.slip;
+                    self.slave_force[s] = st.slave_force;
+                }
+            }
         }
+        Ok(())
+    }
+
+    /// Start the friction history from the current search (the reference
+    /// configuration, before the first increment).
+    pub fn init_history(&mut self) {
+        for s in 0..self.slaves.len() {
+            if self.usable(s) {
+                self.xi_n[s] = self.projections[s].xi;
+            }
+        }
+    }
+
+    /// Slip increment of slave `s` in this increment, (ξ̄ − ξ̄_n)^α ā_α.
+    pub fn slip_increment(&self, s: usize) -> Vec3 {
+        if self.status[s] == SlaveStatus::Outside {
+            return Vec3::zeros();
+        }
+        let law = self.friction_law(s);
+        let xi = self.projections[s].xi;
+        let a = &self.points[s].a_alpha;
+        a[0] * (xi[0] - law.xi_n[0]) + a[1] * (xi[1] - law.xi_n[1])
+    }
+
+    /// Slaves sticking and slipping (active ones, frictional pairs).
+    pub fn n_stick_slip(&self) -> (usize, usize) {
+        let slip = self.slipping.iter().filter(|&&b| b).count();
+        (self.n_active() - slip, slip)
     }
 
     /// Number of active slaves (after [`Self::update_states`]).
@@ -270,15 +353,32 @@ impl PairSolver {
         self.augmentations += 1;
     }
 
-    /// Total force the master exerts on the slave body: Σ −t_N A_s n̄.
+    /// Total force the master exerts on the slave body (Σ −r_s over the slaves):
+    /// normal Σ −t_N A_s n̄ plus, with friction, the tangential part.
     pub fn total_force(&self) -> Vec3 {
-        (0..self.slaves.len()).filter(|&s| self.status[s] == SlaveStatus::Active).map(|s| self.points[s].n_bar * (-self.t_n[s] * self.areas[s])).sum()
+        self.slave_force.iter().sum()
     }
 
-    /// The increment converged: keep its multipliers.
+    /// The tangential part of [`Self::total_force`] (zero without friction).
+    pub fn tangential_force(&self) -> Vec3 {
+        (0..self.slaves.len())
+            .filter(|&s| self.status[s] == SlaveStatus::Active)
+            .map(|s| self.slave_force[s] - self.points[s].n_bar * (-self.t_n[s] * self.areas[s]))
+            .sum()
+    }
+
+    /// The increment converged: keep its multipliers and, with friction, the history
+    /// (ξ̄_n ← ξ̄; t_{Tα,n} ← t_Tα for active nodes, 0 for the others: a node that
+    /// leaves contact forgets its traction).
     pub fn commit(&mut self) {
         self.lambda_committed.copy_from_slice(&self.lambda_n);
         self.augmentations = 0;
+        for s in 0..self.slaves.len() {
+            if self.status[s] != SlaveStatus::Outside {
+                self.xi_n[s] = self.projections[s].xi;
+            }
+            self.t_t_n[s] = if self.status[s] == SlaveStatus::Active { self.t_t[s] } else { [0.0; 2] };
+        }
     }
 
     /// The increment failed: back to the last converged multipliers.

@@ -67,7 +67,26 @@ pub struct PairSummary {
     pub augmentations: u32,
     /// False when the augmentations ran out with the penetration still above tolerance.
     pub penetration_converged: bool,
+    /// Frictional pairs: the tangential part of `force`, and the active nodes sticking
+    /// and slipping.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub friction: Option<FrictionSummary>,
 }
+
+/// Friction of one pair at the end of an increment.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct FrictionSummary {
+    pub tangential_force: [f64; 3],
+    pub stick: u32,
+    pub slip: u32,
+}
+
+/// Columns of the per-slave-node friction array `inc/<k>/pair/<p>/friction`
+/// (frictional pairs only): the tangential traction vector t_T, the slip increment
+/// (ξ̄ − ξ̄_n)^α ā_α of the increment, the covariant t_Tα (the history a restart needs,
+/// with ξ̄ in `state`), and 0 (not active) / 1 (stick) / 2 (slip).
+pub const FRICTION_COLUMNS: [&str; 9] = ["t_t_x", "t_t_y", "t_t_z", "slip_x", "slip_y", "slip_z", "t_t_1", "t_t_2", "stick_slip"];
 
 /// Columns of the per-slave-node contact state array `inc/<k>/pair/<p>/state`.
 pub const CONTACT_STATE_COLUMNS: [&str; 6] = ["g_n", "t_n", "lambda_n", "status", "xi_1", "xi_2"];
@@ -106,6 +125,8 @@ pub struct Increment {
     /// Per pair, per slave node: g_N, t_N, λ_N, status (−1 outside the patch, 0 open,
     /// 1 active), ξ̄¹, ξ̄² (see [`CONTACT_STATE_COLUMNS`]).
     pub contact: Vec<Vec<[f64; 6]>>,
+    /// Per pair, per slave node: [`FRICTION_COLUMNS`]; empty for frictionless pairs.
+    pub friction: Vec<Vec<[f64; 9]>>,
 }
 
 #[derive(Debug, Serialize, Deserialize)]
@@ -161,6 +182,10 @@ impl Results {
                 let v: Vec<f64> = state.iter().flatten().copied().collect();
                 w.f64s(&format!("inc/{k}/pair/{p}/state"), &[state.len() as u64, 6], &v);
             }
+            for (p, fr) in inc.friction.iter().enumerate().filter(|(_, f)| !f.is_empty()) {
+                let v: Vec<f64> = fr.iter().flatten().copied().collect();
+                w.f64s(&format!("inc/{k}/pair/{p}/friction"), &[fr.len() as u64, 9], &v);
+            }
         }
         w.finish()
     }
@@ -199,7 +224,20 @@ impl Results {
                 }
                 contact.push(v.chunks_exact(6).map(|c| std::array::from_fn(|i| c[i])).collect());
             }
-            increments.push(Increment { info, u: u.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(), stress, contact });
+            let mut friction = Vec::with_capacity(pairs.len());
+            for (p, pair) in pairs.iter().enumerate() {
+                let name = format!("inc/{k}/pair/{p}/friction");
+                if f.array(&name).is_none() {
+                    friction.push(Vec::new());
+                    continue;
+                }
+                let v = f.f64s(&name, Some(9))?;
+                if v.len() != 9 * pair.slave_nodes.len() {
+                    return Err(f.invalid(&name, format!("expected {} slave nodes of pair '{}' × 9", pair.slave_nodes.len(), pair.name)));
+                }
+                friction.push(v.chunks_exact(9).map(|c| std::array::from_fn(|i| c[i])).collect());
+            }
+            increments.push(Increment { info, u: u.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(), stress, contact, friction });
         }
         Ok(Self { mesh, source: meta.source, setup: meta.setup, status: meta.status, increments, pairs })
     }

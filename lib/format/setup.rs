@@ -218,6 +218,16 @@ pub struct ContactSetup {
     /// Most Uzawa updates per increment.
     #[serde(default = "default_max_augmentations")]
     pub max_augmentations: u32,
+    /// Coulomb friction coefficient μ (0: frictionless).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub mu: f64,
+    /// Tangential penalty ε_T (traction per unit elastic slip); required when μ > 0.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub eps_t: Option<f64>,
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
 }
 
 fn default_max_augmentations() -> u32 {

@@ -13,7 +13,7 @@ use super::log::{IterationEvent, SolveLog};
 use super::newton::{gauss_stresses, IncrementFailure, Newton};
 use super::uzawa::solve_augmented;
 use crate::contact::pair::SlaveStatus;
-use crate::format::scres::PairSummary;
+use crate::format::scres::{FrictionSummary, PairSummary};
 use crate::format::setup::Enforcement;
 use super::problem::Problem;
 use crate::assembly::DOFS_PER_NODE;
@@ -75,9 +75,10 @@ fn worst_element(p: &Problem, results: &Results, failure: &IncrementFailure, tri
 
 /// Each pair's summary and per-slave state at the converged increment (states
 /// updated by the Uzawa loop).
-fn contact_results(newton: &Newton) -> (Vec<PairSummary>, Vec<Vec<[f64; 6]>>) {
+fn contact_results(newton: &Newton) -> (Vec<PairSummary>, Vec<Vec<[f64; 6]>>, Vec<Vec<[f64; 9]>>) {
     let mut summaries = Vec::with_capacity(newton.contact.len());
     let mut states = Vec::with_capacity(newton.contact.len());
+    let mut friction = Vec::with_capacity(newton.contact.len());
     for c in &newton.contact {
         let f = c.total_force();
         let max_penetration = c.max_penetration();
@@ -88,6 +89,26 @@ fn contact_results(newton: &Newton) -> (Vec<PairSummary>, Vec<Vec<[f64; 6]>>) {
             max_penetration,
             augmentations: c.augmentations,
             penetration_converged: c.settings.enforcement == Enforcement::Penalty || max_penetration <= c.settings.penetration_tolerance,
+            friction: c.settings.frictional().then(|| {
+                let t = c.tangential_force();
+                let (stick, slip) = c.n_stick_slip();
+                FrictionSummary { tangential_force: [t[0], t[1], t[2]], stick: stick as u32, slip: slip as u32 }
+            }),
+        });
+        friction.push(if c.settings.frictional() {
+            (0..c.slaves.len())
+                .map(|s| {
+                    let (t, d) = (c.t_t_vector[s], c.slip_increment(s));
+                    let code = match (c.status[s], c.slipping[s]) {
+                        (SlaveStatus::Active, false) => 1.0,
+                        (SlaveStatus::Active, true) => 2.0,
+                        _ => 0.0,
+                    };
+                    [t[0], t[1], t[2], d[0], d[1], d[2], c.t_t[s][0], c.t_t[s][1], code]
+                })
+                .collect()
+        } else {
+            Vec::new()
         });
         states.push(
             (0..c.slaves.len())
@@ -99,7 +120,7 @@ fn contact_results(newton: &Newton) -> (Vec<PairSummary>, Vec<Vec<[f64; 6]>>) {
                 .collect(),
         );
     }
-    (summaries, states)
+    (summaries, states, friction)
 }
 
 /// Run all increments; `results` holds the mesh and setup and receives the increments.
@@ -162,7 +183,7 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
                     };
                     summary.iterations += conv.iterations.len().saturating_sub(1);
                     let reactions = newton.reactions().into_iter().map(|(set, force)| Reaction { set, force }).collect();
-                    let (summaries, states) = contact_results(newton);
+                    let (summaries, states, friction) = contact_results(newton);
                     for s in &summaries {
                         if !s.penetration_converged {
                             log.line(&format!(
@@ -182,6 +203,7 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
                         u: u.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
                         stress,
                         contact: states,
+                        friction,
                     });
                     write(results, log)?;
                     if let Some(last) = results.increments.last_mut() {

@@ -96,6 +96,9 @@ impl<'p> Newton<'p> {
         }
         let mut owners = Vec::new();
         let groups = contact_groups(problem, &mut contact, &vec![0.0; DOFS_PER_NODE * problem.n_nodes()], &mut owners)?;
+        for pair in &mut contact {
+            pair.init_history();
+        }
         let pattern = Pattern::build(problem.dofs.clone(), &problem.hexes, groups)?;
         let assembly = Assembly::new(&pattern)?;
         let (symmetry, strategy) = match choice {

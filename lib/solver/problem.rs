@@ -143,6 +143,12 @@ fn contact_definitions(mesh: &Mesh, pairs: &[ContactPair], setup: &SolveSetup, f
                 }
             }
         }
+        let eps_t = match (c.mu, c.eps_t) {
+            (mu, _) if !(mu.is_finite() && mu >= 0.0) => return Err(bad(format!("mu must be zero or positive, found {mu}"))),
+            (mu, None) if mu > 0.0 => return Err(bad("friction (mu > 0) needs the tangential penalty `eps_t`".into())),
+            (_, Some(e)) if !(e.is_finite() && e > 0.0) => return Err(bad(format!("eps_t must be a positive number, found {e}"))),
+            (_, e) => e.unwrap_or(0.0),
+        };
         let areas = tributary_areas(mesh, &pair.slave_nodes, (pair.slave_kind == SlaveKind::FaceSet).then_some(pair.slave.as_str()));
         let h = mean_net_edge(mesh, pair);
         let penetration_tolerance = match (c.penetration_tolerance, c.penetration_tolerance_relative) {
@@ -153,7 +159,7 @@ fn contact_definitions(mesh: &Mesh, pairs: &[ContactPair], setup: &SolveSetup, f
         };
         out.push(ContactDefinition {
             pair: pair.clone(),
-            settings: PairSettings { eps_n: c.eps_n, enforcement: c.enforcement, penetration_tolerance, max_augmentations: c.max_augmentations },
+            settings: PairSettings { eps_n: c.eps_n, enforcement: c.enforcement, penetration_tolerance, max_augmentations: c.max_augmentations, mu: c.mu, eps_t },
             areas,
             h_master: h,
         });
@@ -324,9 +330,9 @@ impl Problem {
         (X, ue)
     }
 
-    /// True if the tangent is symmetric (no follower pressure; frictionless contact
-    /// keeps it symmetric).
+    /// True if the tangent is symmetric: no follower pressure and no friction
+    /// (frictionless contact keeps it symmetric; slip makes it non-symmetric).
     pub fn symmetric(&self) -> bool {
-        self.pressure_faces.is_empty()
+        self.pressure_faces.is_empty() && self.contact.iter().all(|c| !c.settings.frictional())
     }
 }

@@ -19,8 +19,14 @@ pub fn solve_augmented(newton: &mut Newton, lambda: f64, u: &mut [f64], on_itera
         let conv = newton.solve_increment(lambda, u, on_iteration)?;
         iterations.extend(conv.iterations);
         let mut due = false;
+        let node_tags = &newton.problem.node_tags;
         for pair in &mut newton.contact {
-            pair.update_states();
+            pair.update_states().map_err(|(node, error)| IncrementFailure::Contact {
+                iteration: 0,
+                pair: pair.name.clone(),
+                node_tag: node_tags.get(node as usize).copied().unwrap_or(node as u64),
+                error,
+            })?;
             if pair.needs_augmentation() {
                 note(&format!(
                     "pair '{}': largest penetration {:.3e} > tolerance {:.3e}, {} active nodes: augmentation {} (λ_N ← t_N)",

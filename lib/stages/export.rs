@@ -90,6 +90,7 @@ pub fn write_results_pvd(results: &Results, output: &Path) -> Result<String, Sta
         u: vec![[0.0; 3]; mesh.nodes.len()],
         stress: vec![[[0.0; 9]; 8]; mesh.hexes.len()],
         contact: vec![],
+        friction: vec![],
     };
     for (k, inc) in std::iter::once(&zero).chain(results.increments.iter()).enumerate() {
         let name = format!("{stem}_{k}.vtu");
