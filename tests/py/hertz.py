@@ -14,13 +14,20 @@ Definitions (the mesh: half cylinder x >= 0, one element layer in z, thickness t
 - E*: 1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2 (cylinder and block).
 - Closed form (Johnson, Contact Mechanics, 5.3) for the measured P:
   b_hertz = sqrt(4 P R / (pi E*)), p0_hertz = 2 P / (pi b_hertz).
-- Contact line: the slave nodes (contact_status > -2) on the face z = 0, ordered by x;
-  positions are CURRENT x = X + u_x (x_ref: reference). Active: contact_pressure > 0.
+- Contact line: the slave nodes (contact_status > -2) on the face z = 0, ordered by
+  their reference x. contact_pressure is t_N, a force per REFERENCE area (the solver's
+  tributary areas are reference ones), so the consistent abscissa is the cylinder's
+  reference x (then the integral of p dx is P): b_* are measured on it. The *_current
+  values use the current x + u_x, where the (nearly rigid) block sees the contact;
+  the two differ by the surface's inward u_x (~1.7 % of b at P = 10), a
+  finite-displacement effect that linear (Hertz) theory does not resolve.
+  Active: contact_pressure > 0.
 - p0_fe = max contact_pressure (the node on the symmetry plane).
 - Half-width: the pressure is nodal, so the edge lies between the last active node
-  (x_lo) and the first open node (x_hi); b_fe = (x_lo + x_hi)/2, bracket +-(x_hi - x_lo)/2
-  (an O(h) measure). Secondary: b_fit, p0_fit from a least-squares fit of the Hertz
-  ellipse p^2 = p0^2 (1 - x^2/b^2) (linear in x^2) to the active nodes.
+  (x_lo) and the first open node (x_hi): b_fe = (x_lo + x_hi)/2 with the bracket
+  b_bracket = [x_lo, x_hi] (an O(h) measure: b_hertz_in_bracket says whether the
+  closed form lies in it). b_fit, p0_fit: least-squares fit of the Hertz ellipse
+  p^2 = p0^2 (1 - x^2/b^2) (linear in x^2) to the active nodes (uses them all).
 - h_slave: the slave (cylinder) node spacing at x = 0 (arc length of its first
   element); h_master: the master (block_top) element length at x = 0.
 - newton: Newton corrections (linear solves) summed over increments, from the CSV;
@@ -71,25 +78,28 @@ def main():
     other = other[np.argsort(X[other, 0])]
     z_mismatch = float(np.abs(p[slave] - p[other]).max()) if len(other) == len(slave) else None
 
-    ps, xs, xr = p[slave], x[slave, 0], X[slave, 0]
+    ps, xr, xc = p[slave], X[slave, 0], x[slave, 0]
     active = ps > 0
     if not active.any():
         raise SystemExit("no active slave node")
     n_act = int(np.argmax(~active)) if (~active).any() else len(ps)
     if not active[:n_act].all() or active[n_act:].any():
         print("warning: active set is not contiguous from x = 0", file=sys.stderr)
-    last, first_open = n_act - 1, n_act
-    x_lo = xs[last]
-    x_hi = xs[first_open] if first_open < len(xs) else float("nan")
-    b_fe = 0.5 * (x_lo + x_hi)
-    b_ref = 0.5 * (xr[last] + xr[first_open]) if first_open < len(xs) else float("nan")
     p0_fe = float(ps.max())
 
-    # Hertz ellipse fit: p^2 = A - B x^2 over the active nodes
-    A = np.vstack([np.ones(n_act), -xs[:n_act] ** 2]).T
-    (c0, c1), *_ = np.linalg.lstsq(A, ps[:n_act] ** 2, rcond=None)
-    p0_fit = math.sqrt(c0) if c0 > 0 else float("nan")
-    b_fit = math.sqrt(c0 / c1) if c0 > 0 and c1 > 0 else float("nan")
+    def half_width(xs):
+        """(midpoint, [last active, first open], b_fit, p0_fit) on abscissa xs."""
+        lo = float(xs[n_act - 1])
+        hi = float(xs[n_act]) if n_act < len(xs) else float("nan")
+        # Hertz ellipse fit: p^2 = c0 - c1 x^2 over the active nodes
+        A = np.vstack([np.ones(n_act), -xs[:n_act] ** 2]).T
+        (c0, c1), *_ = np.linalg.lstsq(A, ps[:n_act] ** 2, rcond=None)
+        b_fit = math.sqrt(c0 / c1) if c0 > 0 and c1 > 0 else float("nan")
+        p0_fit = math.sqrt(c0) if c0 > 0 else float("nan")
+        return 0.5 * (lo + hi), [lo, hi], b_fit, p0_fit
+
+    b_fe, bracket, b_fit, p0_fit = half_width(xr)
+    b_fe_cur, bracket_cur, b_fit_cur, _ = half_width(xc)
 
     incs = sr.scres_summary(scres)
     inc = incs[-1]
@@ -116,11 +126,14 @@ def main():
         "h_master": None if h_master is None else round(h_master, 5),
         "E_star": round(Estar, 3),
         "P": P, "P_contact": P_contact,
-        "b_fe": b_fe, "b_bracket": [float(x_lo), float(x_hi)], "b_fe_reference_x": float(b_ref),
-        "b_hertz": b_h, "b_err": b_fe / b_h - 1.0,
-        "p0_fe": p0_fe, "p0_hertz": p0_h, "p0_err": p0_fe / p0_h - 1.0,
-        "b_fit": b_fit, "p0_fit": p0_fit,
-        "b_fit_err": b_fit / b_h - 1.0, "p0_fit_err": p0_fit / p0_h - 1.0,
+        "b_hertz": b_h, "p0_hertz": p0_h,
+        "b_fe": b_fe, "b_bracket": bracket, "b_err": b_fe / b_h - 1.0,
+        "b_hertz_in_bracket": bool(bracket[0] <= b_h <= bracket[1]),
+        "b_fit": b_fit, "b_fit_err": b_fit / b_h - 1.0,
+        "p0_fe": p0_fe, "p0_err": p0_fe / p0_h - 1.0,
+        "p0_fit": p0_fit, "p0_fit_err": p0_fit / p0_h - 1.0,
+        "b_fe_current": b_fe_cur, "b_bracket_current": bracket_cur, "b_err_current": b_fe_cur / b_h - 1.0,
+        "b_fit_current": b_fit_cur, "b_fit_err_current": b_fit_cur / b_h - 1.0,
         "active_nodes_line": n_act,
         "pressure_z0_z1_mismatch": z_mismatch,
         "max_penetration": float(pair["max_penetration"]),

@@ -102,7 +102,10 @@ def scres_summary(scres):
     text = subprocess.run([exe, scres, "--format", "yaml", "-o", "-"], check=True,
                           capture_output=True, text=True).stdout
     lines = text.split("\n")
-    start = lines.index("  increments:") + 1
+    head = [i for i, l in enumerate(lines) if l.startswith("  increments:")]
+    if not head or lines[head[0]].strip() == "increments: []":
+        return []
+    start = head[0] + 1
     end = start
     while end < len(lines) and (_indent(lines[end]) > 2 or lines[end].startswith("  -")):
         end += 1
