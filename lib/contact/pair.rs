@@ -80,16 +80,21 @@ impl Projector {
             Self::Facet(p) => p.update(x),
         }
     }
-    fn project(&self, p: &Vec3) -> Projection {
+    /// The projection and, for facets, the cell it lies on (kept from `prev` at ties).
+    fn project(&self, p: &Vec3, prev: Option<[usize; 2]>) -> (Projection, Option<[usize; 2]>) {
         match self {
-            Self::BSpline(pr) => pr.project(p),
-            Self::Facet(pr) => pr.project(p),
+            Self::BSpline(pr) => (pr.project(p), None),
+            Self::Facet(pr) => {
+                let (proj, cell) = pr.project_keeping(p, prev);
+                (proj, Some(cell))
+            }
         }
     }
-    fn evaluate(&self, xi: [f64; 2]) -> SurfacePoint {
-        match self {
-            Self::BSpline(p) => p.evaluate(xi),
-            Self::Facet(p) => p.evaluate(xi),
+    fn evaluate(&self, xi: [f64; 2], cell: Option<[usize; 2]>) -> SurfacePoint {
+        match (self, cell) {
+            (Self::BSpline(p), _) => p.evaluate(xi),
+            (Self::Facet(p), Some(c)) => p.evaluate_in_cell(xi, c),
+            (Self::Facet(p), None) => p.evaluate(xi),
         }
     }
 }
@@ -119,6 +124,9 @@ pub struct PairSolver {
     /// Last search: projections, surface points at ξ̄, slave positions.
     pub projections: Vec<Projection>,
     points: Vec<SurfacePoint>,
+    /// Facet masters: the cell of each foot point (kept at ties, see
+    /// [`FacetProjector::project_keeping`]).
+    cells: Vec<Option<[usize; 2]>>,
     x_slave: Vec<Vec3>,
     /// After [`Self::update_states`]: t_N and the status of every slave.
     pub t_n: Vec<f64>,
@@ -173,6 +181,7 @@ impl PairSolver {
             lambda_committed: vec![0.0; n],
             projections: vec![Projection { xi: [0.0; 2], x_bar: Vec3::zeros(), g: f64::INFINITY, inside: false, iterations: 0, converged: false }; n],
             points: vec![SurfacePoint::default(); n],
+            cells: vec![None; n],
             x_slave: vec![Vec3::zeros(); n],
             t_n: vec![0.0; n],
             status: vec![SlaveStatus::Outside; n],
@@ -201,12 +210,15 @@ impl PairSolver {
         self.projections
             .par_iter_mut()
             .zip(self.points.par_iter_mut())
+            .zip(self.cells.par_iter_mut())
             .zip(self.x_slave.par_iter())
             .with_min_len(64)
-            .for_each(|((proj, sp), xs)| {
-                *proj = projector.project(xs);
+            .for_each(|(((proj, sp), cell), xs)| {
+                let (pr, c) = projector.project(xs, *cell);
+                *proj = pr;
+                *cell = c;
                 if proj.converged {
-                    *sp = projector.evaluate(proj.xi);
+                    *sp = projector.evaluate(proj.xi, c);
                 }
             });
         Ok(())
@@ -332,6 +344,13 @@ impl PairSolver {
     /// count for progress lines, before the states are updated).
     pub fn n_pressed(&self) -> usize {
         (0..self.slaves.len()).filter(|&s| self.usable(s) && self.lambda_n[s] + self.settings.eps_n * self.projections[s].g < 0.0).count()
+    }
+
+    /// Slaves whose closest-point projection failed at the last search (treated as
+    /// out of contact), and the first of them.
+    pub fn failed_projections(&self) -> (usize, Option<u32>) {
+        let failed: Vec<u32> = (0..self.slaves.len()).filter(|&s| !self.projections[s].converged).map(|s| self.slaves[s]).collect();
+        (failed.len(), failed.first().copied())
     }
 
     /// Largest penetration −g_N over the active slaves (0 if none).

@@ -67,10 +67,17 @@ pub struct PairSummary {
     pub augmentations: u32,
     /// False when the augmentations ran out with the penetration still above tolerance.
     pub penetration_converged: bool,
+    /// Slave nodes whose closest-point projection failed (counted as out of contact).
+    #[serde(default, skip_serializing_if = "is_zero_u32")]
+    pub unprojected: u32,
     /// Frictional pairs: the tangential part of `force`, and the active nodes sticking
     /// and slipping.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub friction: Option<FrictionSummary>,
+}
+
+fn is_zero_u32(v: &u32) -> bool {
+    *v == 0
 }
 
 /// Friction of one pair at the end of an increment.

@@ -89,6 +89,7 @@ fn contact_results(newton: &Newton) -> (Vec<PairSummary>, Vec<Vec<[f64; 6]>>, Ve
             max_penetration,
             augmentations: c.augmentations,
             penetration_converged: c.settings.enforcement == Enforcement::Penalty || max_penetration <= c.settings.penetration_tolerance,
+            unprojected: c.failed_projections().0 as u32,
             friction: c.settings.frictional().then(|| {
                 let t = c.tangential_force();
                 let (stick, slip) = c.n_stick_slip();
@@ -184,6 +185,16 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
                     summary.iterations += conv.iterations.len().saturating_sub(1);
                     let reactions = newton.reactions().into_iter().map(|(set, force)| Reaction { set, force }).collect();
                     let (summaries, states, friction) = contact_results(newton);
+                    for c in &newton.contact {
+                        if let (n, Some(node)) = c.failed_projections() {
+                            log.line(&format!(
+                                "increment {}/{n_inc}: warning: pair '{}': the closest-point projection failed for {n} slave nodes (first: node {}); they are treated as out of contact",
+                                k + 1,
+                                c.name,
+                                p.node_tags.get(node as usize).copied().unwrap_or(node as u64)
+                            ));
+                        }
+                    }
                     for s in &summaries {
                         if !s.penetration_converged {
                             log.line(&format!(

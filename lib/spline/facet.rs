@@ -169,22 +169,50 @@ impl FacetProjector {
 
     /// Closest point of the facet set to `p`.
     pub fn project(&self, p: &Vec3) -> Projection {
+        self.project_keeping(p, None).0
+    }
+
+    /// Bounded Newton on one cell.
+    fn in_cell(&self, p: &Vec3, cell: [usize; 2]) -> NewtonResult {
         let o = &self.options;
-        let tol = o.tol * self.scale;
-        let mut best: Option<(f64, NewtonResult)> = None;
+        let bounds = self.facets.cell_bounds(cell);
+        let width = [bounds.1[0] - bounds.0[0], bounds.1[1] - bounds.0[1]];
+        let mid = [0.5 * (bounds.0[0] + bounds.1[0]), 0.5 * (bounds.0[1] + bounds.1[1])];
+        newton(|xi| self.facets.jet_in_cell(&self.x, cell, xi), p, mid, bounds, width, o.tol * self.scale, o.max_iterations)
+    }
+
+    /// Closest point of the facet set to `p` and the cell it lies on, with
+    /// hysteresis: the cell `prev` (used at the last search) is kept while its foot
+    /// point is no farther than the best by 1e-6 of the net's size. A node on the
+    /// shared edge of two facets (a crease) then keeps one facet and its normal
+    /// instead of flipping between them from one Newton iterate to the next.
+    pub fn project_keeping(&self, p: &Vec3, prev: Option<[usize; 2]>) -> (Projection, [usize; 2]) {
+        let mut best: Option<(f64, NewtonResult, [usize; 2])> = None;
         self.tree.query(p, f64::INFINITY, |cell, _| {
-            let bounds = self.facets.cell_bounds(cell);
-            let width = [bounds.1[0] - bounds.0[0], bounds.1[1] - bounds.0[1]];
-            let mid = [0.5 * (bounds.0[0] + bounds.1[0]), 0.5 * (bounds.0[1] + bounds.1[1])];
-            let res = newton(|xi| self.facets.jet_in_cell(&self.x, cell, xi), p, mid, bounds, width, tol, o.max_iterations);
+            let res = self.in_cell(p, cell);
             let d2 = (p - res.jet.x).norm_squared();
             if best.as_ref().is_none_or(|b| d2 < b.0) {
-                best = Some((d2, res));
+                best = Some((d2, res, cell));
             }
             best.as_ref().map_or(f64::INFINITY, |b| b.0)
         });
-        let (_, res) = best.expect("the tree has at least one cell");
-        finish(p, &res, o.outside_tol * self.scale)
+        let (d2, mut res, mut cell) = best.expect("the tree has at least one cell");
+        if let Some(c) = prev.filter(|&c| c != cell) {
+            let kept = self.in_cell(p, c);
+            let slack = 1e-6 * self.scale;
+            if kept.converged && (p - kept.jet.x).norm() <= d2.sqrt() + slack {
+                res = kept;
+                cell = c;
+            }
+        }
+        (finish(p, &res, self.options.outside_tol * self.scale), cell)
+    }
+
+    /// Evaluation at ξ on a given cell (the one [`Self::project_keeping`] returned).
+    pub fn evaluate_in_cell(&self, xi: [f64; 2], cell: [usize; 2]) -> SurfacePoint {
+        let mut out = SurfacePoint::default();
+        self.facets.evaluate_in_cell_into(&self.x, cell, xi, &mut out);
+        out
     }
 
     /// Projects every point, in parallel (rayon).

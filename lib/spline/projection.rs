@@ -355,10 +355,45 @@ impl BSplineProjector {
         finish(p, &res, o.outside_tol * self.scale)
     }
 
-    /// Closest point of the patch to `p` (global search, then Newton).
+    /// Closest point of the patch to `p` (global search, then Newton; if Newton on
+    /// the whole domain fails — at a kink of a C⁰ patch, order 2 — a box-constrained
+    /// Newton per candidate span, as for facets).
     pub fn project(&self, p: &Vec3) -> Projection {
         let xi0 = self.global_start(p);
-        self.newton_from(p, xi0)
+        let res = self.newton_from(p, xi0);
+        if res.converged {
+            return res;
+        }
+        let by_span = self.project_by_spans(p);
+        if by_span.converged {
+            by_span
+        } else {
+            res
+        }
+    }
+
+    /// Step 2 span by span: Newton bounded to each candidate span of the tree
+    /// (branch and bound on the best distance found), the nearest result wins.
+    fn project_by_spans(&self, p: &Vec3) -> Projection {
+        let o = &self.options;
+        let tol = o.tol * self.scale;
+        let mut best: Option<(f64, NewtonResult)> = None;
+        self.tree.query(p, f64::INFINITY, |[s, t], _| {
+            let (a0, a1) = self.patch.knots(0).span_bounds(s);
+            let (b0, b1) = self.patch.knots(1).span_bounds(t);
+            let bounds = ([a0, b0], [a1, b1]);
+            let mid = [0.5 * (a0 + a1), 0.5 * (b0 + b1)];
+            let res = newton(|xi| self.patch.jet(&self.x, xi), p, mid, bounds, [a1 - a0, b1 - b0], tol, o.max_iterations);
+            let d2 = (p - res.jet.x).norm_squared();
+            if res.converged && best.as_ref().is_none_or(|b| d2 < b.0) {
+                best = Some((d2, res));
+            }
+            best.as_ref().map_or(f64::INFINITY, |b| b.0)
+        });
+        match best {
+            Some((_, res)) => finish(p, &res, o.outside_tol * self.scale),
+            None => Projection { xi: [f64::NAN; 2], x_bar: Vec3::from_element(f64::NAN), g: f64::NAN, inside: false, iterations: 0, converged: false },
+        }
     }
 
     /// Newton started from a previous ξ̄ (the local minimum near it); falls back to
