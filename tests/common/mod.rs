@@ -74,8 +74,15 @@ pub fn gmsh_mesh(geo: &Path, out: &Path, flags: &[&str]) {
     assert!(o.status.success() && out.is_file(), "gmsh failed: {}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
 }
 
+/// Run `tests/py/<script>` with the test Python; scripts that read results files find
+/// this build's `sc-export` through `$SC_EXPORT`.
 pub fn python_script(script: &str, args: &[&Path]) -> Output {
-    Command::new(python()).arg(repo().join("tests/py").join(script)).args(args).output().expect("python runs")
+    Command::new(python())
+        .arg(repo().join("tests/py").join(script))
+        .args(args)
+        .env("SC_EXPORT", env!("CARGO_BIN_EXE_sc-export"))
+        .output()
+        .expect("python runs")
 }
 
 pub fn tempdir() -> tempfile::TempDir {

@@ -1,3 +1,4 @@
 mod solid;
 mod contact;
 mod parisch;
+mod benchmarks;
