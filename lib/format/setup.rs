@@ -101,6 +101,10 @@ pub struct ConstraintSetup {
     #[serde(default)]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub displacement: Option<Components>,
+    /// Amplitude of `displacement` over the load factor ("time") t: a name from
+    /// `curves`; default the ramp a(t) = t.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub curve: Option<String>,
 }
 
 /// A load: a force on a node set (total, spread evenly over its nodes, or
@@ -119,9 +123,23 @@ pub struct LoadSetup {
     /// Follower pressure (positive pushes against the face's outward normal).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub pressure: Option<f64>,
+    /// Amplitude over the load factor t (a name from `curves`; default a(t) = t).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub curve: Option<String>,
 }
 
-/// Load factors: `count` equal increments up to 1, or an explicit increasing list.
+/// A piecewise-linear amplitude a(t) through `points` [[t, a], …] (t increasing),
+/// constant beyond the ends — e.g. press then slide: a vertical displacement on
+/// [[0, 0], [1, 1], [2, 1]] and a horizontal one on [[0, 0], [1, 0], [2, 1]].
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct CurveSetup {
+    pub name: String,
+    pub points: Vec<[f64; 2]>,
+}
+
+/// Load factors ("time" t): `count` equal increments up to `end` (default 1), or an
+/// explicit increasing list.
 #[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct IncrementSetup {
@@ -132,6 +150,9 @@ pub struct IncrementSetup {
     /// How many times an increment may be halved before the solve stops.
     #[serde(default = "default_cutbacks")]
     pub max_cutbacks: u32,
+    /// Final load factor for `count` (default 1).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub end: Option<f64>,
 }
 
 fn default_cutbacks() -> u32 {
@@ -140,7 +161,7 @@ fn default_cutbacks() -> u32 {
 
 impl Default for IncrementSetup {
     fn default() -> Self {
-        Self { count: Some(1), factors: None, max_cutbacks: default_cutbacks() }
+        Self { count: Some(1), factors: None, max_cutbacks: default_cutbacks(), end: None }
     }
 }
 
@@ -251,6 +272,10 @@ pub struct SolveSetup {
     pub newton: NewtonSetup,
     #[serde(default)]
     pub linear_solver: LinearSolverChoice,
+    /// Named amplitudes for constraints and loads.
+    #[serde(default)]
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub curves: Vec<CurveSetup>,
     /// Settings per contact pair (input must then be a `.sccontact`).
     #[serde(default)]
     #[serde(skip_serializing_if = "Vec::is_empty")]
@@ -286,6 +311,7 @@ impl SolveSetup {
         let err = |m: String| SetupError { path: path.into(), message: m };
         match (&self.increments.count, &self.increments.factors) {
             (Some(_), Some(_)) => Err(err("increments: give `count` or `factors`, not both".into())),
+            (_, Some(_)) if self.increments.end.is_some() => Err(err("increments: `end` goes with `count`; `factors` already ends where it ends".into())),
             (_, Some(f)) => {
                 if f.is_empty() || f.iter().any(|x| !x.is_finite() || *x <= 0.0) || f.windows(2).any(|w| w[1] <= w[0]) {
                     Err(err(format!("increments.factors must be positive and strictly increasing, found {f:?}")))
@@ -294,7 +320,13 @@ impl SolveSetup {
                 }
             }
             (Some(0), None) => Err(err("increments.count must be at least 1".into())),
-            (Some(n), None) => Ok((1..=*n).map(|i| i as f64 / *n as f64).collect()),
+            (Some(n), None) => {
+                let end = self.increments.end.unwrap_or(1.0);
+                if !(end.is_finite() && end > 0.0) {
+                    return Err(err(format!("increments.end must be a positive number, found {end}")));
+                }
+                Ok((1..=*n).map(|i| end * i as f64 / *n as f64).collect())
+            }
             (None, None) => Ok(vec![1.0]),
         }
     }

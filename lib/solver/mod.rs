@@ -1,9 +1,10 @@
 //! Solvers: the linear-solver interface and its faer direct backend ([`linear`]),
-//! the static problem ([`problem`]), Newton–Raphson for one increment ([`newton`]),
+//! the static problem ([`problem`]) and its load curves ([`amplitude`]), Newton–Raphson for one increment ([`newton`]),
 //! the augmented Lagrangian's Uzawa loop ([`uzawa`]), load
 //! stepping with cutbacks ([`increments`]), what the user sees ([`log`]), and a
 //! timing benchmark on a clamped elastic cube ([`bench`]).
 
+pub mod amplitude;
 pub mod bench;
 pub mod increments;
 pub mod linear;

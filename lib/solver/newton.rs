@@ -75,6 +75,8 @@ pub struct Newton<'p> {
     residual: Vec<f64>,
     rhs: Vec<f64>,
     r_free: Vec<f64>,
+    /// f_ext at the current load factor.
+    f_ext: Vec<f64>,
     /// The contact pairs' state (search, multipliers, active sets).
     pub contact: Vec<PairSolver>,
     /// Owner of every group of `pattern`.
@@ -120,6 +122,7 @@ impl<'p> Newton<'p> {
             residual: vec![0.0; n],
             rhs: vec![0.0; n_free],
             r_free: vec![0.0; n_free],
+            f_ext: vec![0.0; n],
             contact,
             owners,
             pattern_rebuilds: 0,
@@ -144,7 +147,8 @@ impl<'p> Newton<'p> {
         Ok(())
     }
 
-    /// The full residual R(u) and the free-dof tangent K_ff at `u` (contact search
+    /// The full residual R(u) and the free-dof tangent K_ff at `u` (external forces
+    /// of the last increment solved, zero before any; contact search
     /// included), for checks against finite differences: `(residual, col_ptr,
     /// row_idx, values)`, K_ff in compressed sparse columns over the free dofs.
     pub fn residual_tangent_at(&mut self, u: &[f64], lambda: f64) -> Result<(Vec<f64>, Vec<usize>, Vec<usize>, Vec<f64>), IncrementFailure> {
@@ -194,7 +198,7 @@ impl<'p> Newton<'p> {
                 p.X[n] + Vector3::new(u[d], u[d + 1], u[d + 2])
             });
             let (mut fv, mut km) = (FaceVector::zeros(), FaceMatrix::zeros());
-            follower_pressure_force_stiffness(&x, lambda * f.p, &mut fv, &mut km);
+            follower_pressure_force_stiffness(&x, p.amplitudes[f.amplitude as usize].at(lambda) * f.p, &mut fv, &mut km);
             for i in 0..12 {
                 r[i] = -fv[i];
                 for j in 0..12 {
@@ -216,8 +220,8 @@ impl<'p> Newton<'p> {
                 })
             }
         };
-        for ((out, r), f) in self.residual.iter_mut().zip(full).zip(&p.f_ext) {
-            *out = r - lambda * f;
+        for ((out, r), f) in self.residual.iter_mut().zip(full).zip(&self.f_ext) {
+            *out = r - f;
         }
         Ok(())
     }
@@ -226,10 +230,11 @@ impl<'p> Newton<'p> {
     /// converged state), which is updated in place. `on_iteration` sees each row.
     pub fn solve_increment(&mut self, lambda: f64, u: &mut [f64], on_iteration: &mut dyn FnMut(&IterationLog)) -> Result<Converged, IncrementFailure> {
         let p = self.problem;
-        for &(d, v) in &p.prescribed {
-            u[d] = lambda * v;
+        for pr in &p.prescribed {
+            u[pr.dof] = p.amplitudes[pr.amplitude as usize].at(lambda) * pr.value;
         }
-        let ext_norm = lambda.abs() * p.f_ext.iter().map(|v| v * v).sum::<f64>().sqrt();
+        p.external_force(lambda, &mut self.f_ext);
+        let ext_norm = self.f_ext.iter().map(|v| v * v).sum::<f64>().sqrt();
         let mut log = Vec::new();
         let mut energy0 = 0.0;
         let mut energy = f64::INFINITY;

@@ -7,6 +7,7 @@
 
 use nalgebra::Vector3;
 
+use super::amplitude::Amplitude;
 use crate::assembly::{DofMap, DOFS_PER_NODE};
 use crate::contact::pair::PairSettings;
 use crate::contact::tributary::tributary_areas;
@@ -39,8 +40,19 @@ pub enum ProblemError {
 #[derive(Debug, Clone, Copy)]
 pub struct PressureFace {
     pub nodes: [u32; 4],
-    /// Pressure at load factor 1.
+    /// Pressure at amplitude 1.
     pub p: f64,
+    /// Index into `Problem::amplitudes`.
+    pub amplitude: u32,
+}
+
+/// A prescribed displacement component: u[dof] = value · a(t).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Prescribed {
+    pub dof: usize,
+    pub value: f64,
+    /// Index into `Problem::amplitudes`.
+    pub amplitude: u32,
 }
 
 /// A contact pair of the model with its settings from the setup.
@@ -64,10 +76,13 @@ pub struct Problem {
     pub materials: Vec<MaterialModel>,
     pub formulation: Formulation,
     pub dofs: DofMap,
-    /// (global dof, prescribed value at load factor 1).
-    pub prescribed: Vec<(usize, f64)>,
-    /// External nodal forces at load factor 1, length 3·nodes.
-    pub f_ext: Vec<f64>,
+    /// Nonzero prescribed displacement components.
+    pub prescribed: Vec<Prescribed>,
+    /// Amplitudes: 0 is the ramp a(t) = t, then the setup's curves in order.
+    pub amplitudes: Vec<Amplitude>,
+    /// External nodal forces at amplitude 1, per amplitude (empty when none uses it),
+    /// each of length 3·nodes: f_ext(t) = Σ_a a(t) f_ext[a].
+    pub f_ext: Vec<Vec<f64>>,
     pub pressure_faces: Vec<PressureFace>,
     /// Constrained node sets, for reaction output: (name, nodes).
     pub reaction_sets: Vec<(String, Vec<u32>)>,
@@ -225,14 +240,35 @@ impl Problem {
                 None => return Err(ProblemError::MissingMaterial { file: file.into(), body: mesh.bodies[b as usize].name.clone() }),
             }
         }
+        // Amplitudes.
+        let mut amplitudes = vec![Amplitude::Ramp];
+        for (i, c) in setup.curves.iter().enumerate() {
+            if setup.curves[..i].iter().any(|o| o.name == c.name) {
+                return Err(invalid(format!("curve '{}' is defined twice", c.name)));
+            }
+            amplitudes.push(Amplitude::table(&c.points).map_err(|m| invalid(format!("curve '{}' {m}", c.name)))?);
+        }
+        let amplitude_of = |name: &Option<String>, user: &str| -> Result<u32, ProblemError> {
+            match name {
+                None => Ok(0),
+                Some(n) => setup.curves.iter().position(|c| &c.name == n).map(|i| i as u32 + 1).ok_or_else(|| ProblemError::UnknownName {
+                    file: file.into(),
+                    what: "curve",
+                    name: format!("{n}' (used by {user})"),
+                    available: names(setup.curves.iter().map(|c| c.name.as_str()).collect()),
+                }),
+            }
+        };
         // Dirichlet conditions.
         let n = mesh.nodes.len();
+        let mut amplitude = vec![0u32; DOFS_PER_NODE * n];
         let mut constrained = vec![false; DOFS_PER_NODE * n];
         let mut value = vec![0.0; DOFS_PER_NODE * n];
         let mut reaction_sets = Vec::new();
         for c in &setup.constraints {
             let set = mesh.node_set(&c.set).ok_or_else(|| unknown("node set", &c.set, mesh.node_set_names()))?;
             let prescribed = c.displacement.as_ref().map(|d| d.as_array()).unwrap_or_default();
+            let amp = amplitude_of(&c.curve, &format!("the constraint on '{}'", c.set))?;
             if c.fix.is_empty() && prescribed.iter().all(Option::is_none) {
                 return Err(invalid(format!("constraint on '{}' fixes nothing: give `fix` and/or `displacement`", c.set)));
             }
@@ -255,17 +291,19 @@ impl Problem {
                         let d = DOFS_PER_NODE * node as usize + i;
                         constrained[d] = true;
                         value[d] = *v;
+                        amplitude[d] = amp;
                     }
                 }
             }
             reaction_sets.push((c.set.clone(), set.nodes.clone()));
         }
         let dofs = DofMap::from_constrained_mask(&constrained).map_err(|e| invalid(e.to_string()))?;
-        let prescribed = (0..constrained.len()).filter(|&d| constrained[d] && value[d] != 0.0).map(|d| (d, value[d])).collect();
+        let prescribed = (0..constrained.len()).filter(|&d| constrained[d] && value[d] != 0.0).map(|d| Prescribed { dof: d, value: value[d], amplitude: amplitude[d] }).collect();
         // Loads.
-        let mut f_ext = vec![0.0; DOFS_PER_NODE * n];
+        let mut f_ext: Vec<Vec<f64>> = vec![Vec::new(); amplitudes.len()];
         let mut pressure_faces = Vec::new();
         for (i, l) in setup.loads.iter().enumerate() {
+            let amp = amplitude_of(&l.curve, &format!("load {}", i + 1))?;
             match (&l.set, l.force, &l.face_set, l.pressure) {
                 (Some(s), Some(f), None, None) => {
                     let set = mesh.node_set(s).ok_or_else(|| unknown("node set", s, mesh.node_set_names()))?;
@@ -273,9 +311,13 @@ impl Problem {
                         return Err(invalid(format!("load {} on '{s}': force is not finite", i + 1)));
                     }
                     let share = if l.per_node { 1.0 } else { 1.0 / set.nodes.len() as f64 };
+                    let f_a = &mut f_ext[amp as usize];
+                    if f_a.is_empty() {
+                        f_a.resize(DOFS_PER_NODE * n, 0.0);
+                    }
                     for &node in &set.nodes {
                         for c in 0..3 {
-                            f_ext[DOFS_PER_NODE * node as usize + c] += f[c] * share;
+                            f_a[DOFS_PER_NODE * node as usize + c] += f[c] * share;
                         }
                     }
                 }
@@ -284,7 +326,7 @@ impl Problem {
                     if !p.is_finite() {
                         return Err(invalid(format!("load {} on '{fs}': pressure is not finite", i + 1)));
                     }
-                    pressure_faces.extend(set.faces.iter().map(|&f| PressureFace { nodes: mesh.face_nodes(f), p }));
+                    pressure_faces.extend(set.faces.iter().map(|&f| PressureFace { nodes: mesh.face_nodes(f), p, amplitude: amp }));
                 }
                 _ => {
                     return Err(invalid(format!(
@@ -306,12 +348,24 @@ impl Problem {
             },
             dofs,
             prescribed,
+            amplitudes,
             f_ext,
             pressure_faces,
             reaction_sets,
             contact,
             node_tags: mesh.node_tags.clone(),
         })
+    }
+
+    /// f_ext(t) = Σ_a a(t) f_ext[a] into `out` (length 3·nodes).
+    pub fn external_force(&self, t: f64, out: &mut [f64]) {
+        out.fill(0.0);
+        for (a, f) in self.amplitudes.iter().zip(&self.f_ext).filter(|(_, f)| !f.is_empty()) {
+            let s = a.at(t);
+            for (o, v) in out.iter_mut().zip(f) {
+                *o += s * v;
+            }
+        }
     }
 
     pub fn n_nodes(&self) -> usize {

@@ -137,7 +137,7 @@ fn total_and_updated_lagrangian_agree() {
 #[test]
 fn rigid_rotation_90_degrees() {
     use splinecontact::solver::newton::Newton;
-    use splinecontact::solver::problem::Problem;
+    use splinecontact::solver::problem::{Prescribed, Problem};
     let mut mesh = block([2, 2, 2], [1.0, 1.0, 1.0], 0.25);
     add_node_set(&mut mesh, "a", |x| x == &[0.0, 0.0, 0.0]);
     add_node_set(&mut mesh, "b", |x| x == &[1.0, 0.0, 0.0]);
@@ -159,7 +159,7 @@ fn rigid_rotation_90_degrees() {
             .flat_map(|&n| {
                 let x = mesh.nodes[n as usize];
                 let d = 3 * n as usize;
-                [(d, c * x[0] - s * x[1] - x[0]), (d + 1, s * x[0] + c * x[1] - x[1]), (d + 2, 0.0)]
+                [(d, c * x[0] - s * x[1] - x[0]), (d + 1, s * x[0] + c * x[1] - x[1]), (d + 2, 0.0)].map(|(dof, value)| Prescribed { dof, value, amplitude: 0 })
             })
             .collect();
         let mut newton = Newton::new(&problem, setup.newton.clone(), setup.linear_solver).unwrap();
