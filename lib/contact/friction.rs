@@ -306,15 +306,18 @@ mod tests {
                 // slip of 0.02 in ξ: ε_T a Δξ ≈ 1e3·1·0.02·ns ≈ 20·ns ≫ μ|t_N| = 0.3·2 (slip);
                 // ε_T = 5 gives ≈ 0.1·ns < 0.6 (stick)
                 let back = [xi0[0] - 0.02 / (na as f64), xi0[1] + 0.01 / (nb as f64)];
-                for (eps_t, mu, want_slip) in [(1e3, 0.3, true), (5.0, 0.3, false), (0.0, 0.0, false)] {
-                    let fr = FrictionLaw { mu, eps_t, xi_n: back, t_t_n: [0.05, -0.02] };
+                // third case: μ > 0 but ε_T = 0 and no history: the dual-number path with
+                // zero tangential traction must reproduce the analytical frictionless K
+                for (eps_t, mu, want_slip) in [(1e3, 0.3, true), (5.0, 0.3, false), (0.0, 0.3, false)] {
+                    let t_t_n = if eps_t == 0.0 { [0.0; 2] } else { [0.05, -0.02] };
+                    let fr = FrictionLaw { mu, eps_t, xi_n: back, t_t_n };
                     let (mut r, mut k) = (DVector::zeros(0), DMatrix::zeros(0, 0));
                     let st = frictional_contact(&xs0, &sp0, &normal, &fr, &mut r, &mut k).unwrap();
                     assert!(st.active);
-                    if mu > 0.0 {
+                    if eps_t > 0.0 {
                         assert_eq!(st.slip, want_slip, "order {order} ε_T {eps_t}: {st:?}");
                     } else {
-                        // no friction: the frictionless element, analytical K
+                        // no tangential traction: the frictionless element, analytical K
                         let (mut r2, mut k2) = (DVector::zeros(0), DMatrix::zeros(0, 0));
                         normal_contact(&xs0, &sp0, &normal, &mut r2, &mut k2).unwrap();
                         assert!((&r - &r2).norm() < 1e-12 * r2.norm() && (&k - &k2).norm() < 1e-10 * k2.norm(), "order {order}: dual K vs analytical K");

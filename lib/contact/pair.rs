@@ -145,6 +145,10 @@ pub struct PairSolver {
     /// tangential traction t_{Tα,n} of the last increment (zero when not in contact).
     xi_n: Vec<[f64; 2]>,
     t_t_n: Vec<[f64; 2]>,
+    /// ξ̄_n as committed; `xi_n` also takes, within an increment, the first foot
+    /// point of a node that had none (NaN: never on the patch, or off it at the last
+    /// commit), so its slip is measured from where it first touched.
+    xi_n_committed: Vec<[f64; 2]>,
     /// After [`Self::update_states`], frictional pairs: t_Tα, the traction vector,
     /// slip (else stick), the force on the slave node.
     pub t_t: Vec<[f64; 2]>,
@@ -191,6 +195,7 @@ impl PairSolver {
             edge_tolerance: 1e-3 * h_master,
             augmentations: 0,
             xi_n: vec![[f64::NAN; 2]; n],
+            xi_n_committed: vec![[f64::NAN; 2]; n],
             t_t_n: vec![[0.0; 2]; n],
             t_t: vec![[0.0; 2]; n],
             t_t_vector: vec![Vec3::zeros(); n],
@@ -221,6 +226,11 @@ impl PairSolver {
                     *sp = projector.evaluate(proj.xi, c);
                 }
             });
+        for s in 0..self.slaves.len() {
+            if self.xi_n[s][0].is_nan() && self.usable(s) {
+                self.xi_n[s] = self.projections[s].xi;
+            }
+        }
         Ok(())
     }
 
@@ -262,11 +272,10 @@ impl PairSolver {
         NormalLaw { lambda_n: self.lambda_n[s], eps_n: self.settings.eps_n, area: self.areas[s], touch: self.touch }
     }
 
-    /// The friction law of slave `s`: its history, or (first contact ever) no
-    /// slip so far: ξ̄_n = the current foot point.
+    /// The friction law of slave `s`: its history ξ̄_n, t_{Tα,n} (ξ̄_n is set at the
+    /// first search that finds the node on the patch, see `xi_n_committed`).
     fn friction_law(&self, s: usize) -> FrictionLaw {
-        let xi_n = if self.xi_n[s][0].is_nan() { self.projections[s].xi } else { self.xi_n[s] };
-        FrictionLaw { mu: self.settings.mu, eps_t: self.settings.eps_t, xi_n, t_t_n: self.t_t_n[s] }
+        FrictionLaw { mu: self.settings.mu, eps_t: self.settings.eps_t, xi_n: self.xi_n[s], t_t_n: self.t_t_n[s] }
     }
 
     /// The contact element of slave `s` (group nodes `[slave, control points]`).
@@ -316,11 +325,12 @@ impl PairSolver {
                 self.xi_n[s] = self.projections[s].xi;
             }
         }
+        self.xi_n_committed.copy_from_slice(&self.xi_n);
     }
 
     /// Slip increment of slave `s` in this increment, (ξ̄ − ξ̄_n)^α ā_α.
     pub fn slip_increment(&self, s: usize) -> Vec3 {
-        if self.status[s] == SlaveStatus::Outside {
+        if self.status[s] == SlaveStatus::Outside || self.xi_n[s][0].is_nan() {
             return Vec3::zeros();
         }
         let law = self.friction_law(s);
@@ -393,16 +403,17 @@ impl PairSolver {
         self.lambda_committed.copy_from_slice(&self.lambda_n);
         self.augmentations = 0;
         for s in 0..self.slaves.len() {
-            if self.status[s] != SlaveStatus::Outside {
-                self.xi_n[s] = self.projections[s].xi;
-            }
+            // off the patch: forget the foot point, the next one found starts afresh
+            self.xi_n[s] = if self.status[s] == SlaveStatus::Outside { [f64::NAN; 2] } else { self.projections[s].xi };
             self.t_t_n[s] = if self.status[s] == SlaveStatus::Active { self.t_t[s] } else { [0.0; 2] };
         }
+        self.xi_n_committed.copy_from_slice(&self.xi_n);
     }
 
     /// The increment failed: back to the last converged multipliers.
     pub fn restore(&mut self) {
         self.lambda_n.copy_from_slice(&self.lambda_committed);
+        self.xi_n.copy_from_slice(&self.xi_n_committed);
         self.augmentations = 0;
     }
 

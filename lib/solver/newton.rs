@@ -62,6 +62,8 @@ pub enum SetupFailure {
     Linear(#[from] LinearSolverError),
     #[error(transparent)]
     Contact(#[from] PairError),
+    #[error("linear_solver: {0} needs a symmetric tangent, and this problem's is not ({1}): use auto or lu")]
+    NotSymmetric(&'static str, &'static str),
 }
 
 /// Newton workspace for one problem: the pattern, its symbolic factorization and the
@@ -83,6 +85,8 @@ pub struct Newton<'p> {
     owners: Vec<GroupOwner>,
     /// Times the pattern was rebuilt because contact groups changed.
     pub pattern_rebuilds: u32,
+    /// The symmetry the linear solver was set up for.
+    symmetry: Symmetry,
 }
 
 /// A converged increment's iteration history.
@@ -103,6 +107,10 @@ impl<'p> Newton<'p> {
         }
         let pattern = Pattern::build(problem.dofs.clone(), &problem.hexes, groups)?;
         let assembly = Assembly::new(&pattern)?;
+        if !problem.symmetric() && matches!(choice, LinearSolverChoice::Cholesky | LinearSolverChoice::Ldlt) {
+            let why = if problem.pressure_faces.is_empty() { "friction" } else { "follower pressure" };
+            return Err(SetupFailure::NotSymmetric(if choice == LinearSolverChoice::Cholesky { "cholesky" } else { "ldlt" }, why));
+        }
         let (symmetry, strategy) = match choice {
             LinearSolverChoice::Auto if problem.symmetric() => (Symmetry::Symmetric, SymmetricStrategy::LltThenLdlt),
             LinearSolverChoice::Auto | LinearSolverChoice::Lu => (Symmetry::General, SymmetricStrategy::LltThenLdlt),
@@ -126,6 +134,7 @@ impl<'p> Newton<'p> {
             contact,
             owners,
             pattern_rebuilds: 0,
+            symmetry,
         })
     }
 
@@ -140,8 +149,7 @@ impl<'p> Newton<'p> {
         if &groups != self.pattern.groups() {
             self.pattern = self.pattern.with_groups(groups).map_err(|e| fail(e.to_string()))?;
             self.assembly = Assembly::new(&self.pattern).map_err(|e| fail(e.to_string()))?;
-            let symmetry = if self.problem.symmetric() { Symmetry::Symmetric } else { Symmetry::General };
-            self.linear.analyse(self.pattern.symbolic(), symmetry).map_err(|error| IncrementFailure::Linear { iteration, error })?;
+            self.linear.analyse(self.pattern.symbolic(), self.symmetry).map_err(|error| IncrementFailure::Linear { iteration, error })?;
             self.pattern_rebuilds += 1;
         }
         Ok(())

@@ -251,11 +251,8 @@ impl Problem {
         let amplitude_of = |name: &Option<String>, user: &str| -> Result<u32, ProblemError> {
             match name {
                 None => Ok(0),
-                Some(n) => setup.curves.iter().position(|c| &c.name == n).map(|i| i as u32 + 1).ok_or_else(|| ProblemError::UnknownName {
-                    file: file.into(),
-                    what: "curve",
-                    name: format!("{n}' (used by {user})"),
-                    available: names(setup.curves.iter().map(|c| c.name.as_str()).collect()),
+                Some(n) => setup.curves.iter().position(|c| &c.name == n).map(|i| i as u32 + 1).ok_or_else(|| {
+                    invalid(format!("{user} uses curve '{n}', which `curves` does not define (it has: {})", names(setup.curves.iter().map(|c| c.name.as_str()).collect())))
                 }),
             }
         };

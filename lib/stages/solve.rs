@@ -51,7 +51,7 @@ pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, 
     for c in &newton.contact {
         let s = &c.settings;
         log.line(&format!(
-            "contact pair '{}': {} slave nodes, {} master, ε_N = {:e}, {}{}",
+            "contact pair '{}': {} slave nodes, {} master, ε_N = {:e}, {}{}{}",
             c.name,
             c.slaves.len(),
             c.master_kind.name(),
@@ -63,7 +63,8 @@ pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, 
             match s.enforcement {
                 crate::format::setup::Enforcement::Penalty => String::new(),
                 _ => format!(" (penetration tolerance {:e}, at most {} augmentations)", s.penetration_tolerance, s.max_augmentations),
-            }
+            },
+            if s.frictional() { format!(", Coulomb friction μ = {}, ε_T = {:e}", s.mu, s.eps_t) } else { ", frictionless".into() }
         ));
     }
     log.line(&format!(
