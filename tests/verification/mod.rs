@@ -2,3 +2,4 @@ mod solid;
 mod contact;
 mod parisch;
 mod benchmarks;
+mod friction;

@@ -1,0 +1,81 @@
+//! Coulomb friction at the structural level (issue: friction): a stiff block pressed
+//! on a stiff base, then pushed sideways and back, against the one-dimensional
+//! elastic-slip / Coulomb-slider law the return mapping implements.
+
+use splinecontact::format::sccontact::MasterKind;
+
+use super::contact::{pair, run_contact};
+use crate::common::grid::{block, two_bodies};
+
+const E: f64 = 1.0e7;
+const EPS_N: f64 = 1.0e4;
+const EPS_T: f64 = 1.0e3;
+const MU: f64 = 0.3;
+/// Press depth and the largest push.
+const DZ: f64 = 1.0e-3;
+const UX: f64 = 1.0e-2;
+
+/// Upper block 0.5 × 0.5 × 0.25 (2 × 2 × 1 hex8) on the middle of a 1 × 1 × 0.5 base
+/// (2 × 2 × 1); base clamped; the upper top driven: u_z = −DZ on t ∈ [0, 1], then
+/// u_x = +UX on [1, 2] and back to −UX on [2, 4] (load curves), u_y = 0.
+fn setup() -> String {
+    format!(
+        "materials:\n  - {{body: lower, model: neo_hookean, E: {E:e}, nu: 0.3}}\n  - {{body: upper, model: neo_hookean, E: {E:e}, nu: 0.3}}\n\
+         curves:\n  - {{name: press, points: [[0, 0], [1, 1]]}}\n  - {{name: push, points: [[1, 0], [2, 1], [4, -1]]}}\n\
+         constraints:\n  - {{set: lower_z0, fix: [x, y, z]}}\n  - {{set: upper_z1, displacement: {{z: {}}}, curve: press, fix: [y]}}\n  - {{set: upper_z1, displacement: {{x: {UX:e}}}, curve: push}}\n\
+         contact:\n  - {{pair: c, eps_n: {EPS_N:e}, enforcement: penalty, mu: {MU}, eps_t: {EPS_T:e}}}\n\
+         increments: {{count: 40, end: 4.0}}\n",
+        -DZ
+    )
+}
+
+#[test]
+fn stick_slip_and_reversal_follow_the_coulomb_law() {
+    let mesh = two_bodies("lower", &block([2, 2, 1], [1.0, 1.0, 0.5], 0.0), "upper", &block([2, 2, 1], [0.5, 0.5, 0.25], 0.0), [0.25, 0.25, 0.5]);
+    for (kind, orders) in [(MasterKind::Facet, None), (MasterKind::Bspline, Some([3, 3]))] {
+        let r = run_contact(&mesh, &[pair(kind, orders, "upper_z0", "lower_z1")], &setup());
+        assert_eq!(r.increments.len(), 40, "{kind:?}: every increment converged without cutback");
+        // One-dimensional reference: spring ε_T·A in series with a Coulomb slider of
+        // capacity μN, driven by the top's u_x (the blocks are ~1000× stiffer than the
+        // penalty layers, so the slip is the top's displacement to ~1e-3).
+        let area = 0.25;
+        let mut s_p = 0.0; // plastic slip
+        let mut worst: f64 = 0.0;
+        let (mut sticks, mut slips) = (0, 0);
+        for inc in &r.increments {
+            let t = inc.info.load_factor;
+            let ux = if t <= 1.0 { 0.0 } else if t <= 2.0 { UX * (t - 1.0) } else { UX * (1.0 - (t - 2.0)) };
+            let s = &inc.info.contact[0];
+            let fr = s.friction.as_ref().expect("frictional pair summary");
+            // normal and tangential parts of the force on the slave (upper) block
+            let tang = fr.tangential_force;
+            let n = s.force[2] - tang[2];
+            let h = tang[0]; // opposes the block's motion
+            let mut h_ref = -EPS_T * area * (ux - s_p);
+            if h_ref.abs() > MU * n {
+                h_ref = h_ref.signum() * MU * n;
+                s_p = ux + h_ref / (EPS_T * area);
+            }
+            let err = (h - h_ref).abs() / (MU * n.max(1e-300));
+            if t > 1.0 {
+                worst = worst.max(err);
+                if fr.slip > 0 {
+                    slips += 1;
+                    // sliding: |T| = μ N (every node slides; the base's surface tilts by its
+                    // elastic strain, ~1e-6, so nodal directions differ by that much)
+                    let tn = (tang[0].powi(2) + tang[1].powi(2) + tang[2].powi(2)).sqrt();
+                    assert!((tn - MU * n).abs() < 1e-6 * MU * n, "{kind:?} t = {t}: |T| = {tn} vs μN = {}", MU * n);
+                    assert_eq!(fr.stick, 0, "{kind:?} t = {t}: a rigid block slides as a whole");
+                } else {
+                    sticks += 1;
+                }
+            }
+            eprintln!("{kind:?} t = {t:.2}: u_x {ux:+.4e}, N {n:.6}, H {h:+.6}, reference {h_ref:+.6}, stick {} slip {}", fr.stick, fr.slip);
+        }
+        // stick until ε_T A u_x = μN (u_x* = 3e-3 = 0.3 UX), slip beyond; on the way
+        // back stick for 2 u_x* then slide the other way: both phases occur
+        assert!(sticks >= 6 && slips >= 10, "{kind:?}: {sticks} stick and {slips} slip increments");
+        // 1 % of μN: the blocks' elastic shear and compression (E / ε_T·h ≈ 1e3)
+        assert!(worst < 1e-2, "{kind:?}: tangential force off the Coulomb law by {worst:e} μN");
+    }
+}
