@@ -149,6 +149,7 @@ pub struct PairSolver {
     /// point of a node that had none (NaN: never on the patch, or off it at the last
     /// commit), so its slip is measured from where it first touched.
     xi_n_committed: Vec<[f64; 2]>,
+    t_t_n_committed: Vec<[f64; 2]>,
     /// After [`Self::update_states`], frictional pairs: t_Tα, the traction vector,
     /// slip (else stick), the force on the slave node.
     pub t_t: Vec<[f64; 2]>,
@@ -196,6 +197,7 @@ impl PairSolver {
             augmentations: 0,
             xi_n: vec![[f64::NAN; 2]; n],
             xi_n_committed: vec![[f64::NAN; 2]; n],
+            t_t_n_committed: vec![[0.0; 2]; n],
             t_t_n: vec![[0.0; 2]; n],
             t_t: vec![[0.0; 2]; n],
             t_t_vector: vec![Vec3::zeros(); n],
@@ -368,17 +370,48 @@ impl PairSolver {
         (0..self.slaves.len()).filter(|&s| self.status[s] == SlaveStatus::Active).map(|s| -self.projections[s].g).fold(0.0, f64::max)
     }
 
-    /// Whether another Uzawa update is due (augmented Lagrangian, penetration above
-    /// the tolerance, updates left).
+    /// Largest elastic slip ‖t_T − t_{T,n}‖ / ε_T of a sticking node (0 without
+    /// friction): the tangential constraint violation the augmentation removes.
+    pub fn max_elastic_slip(&self) -> f64 {
+        if !self.settings.frictional() {
+            return 0.0;
+        }
+        (0..self.slaves.len())
+            .filter(|&s| self.status[s] == SlaveStatus::Active && !self.slipping[s])
+            .map(|s| {
+                let d = [self.t_t[s][0] - self.t_t_n[s][0], self.t_t[s][1] - self.t_t_n[s][1]];
+                let ai = self.points[s].a_inv;
+                (d[0] * ai[(0, 0)] * d[0] + 2.0 * d[0] * ai[(0, 1)] * d[1] + d[1] * ai[(1, 1)] * d[1]).max(0.0).sqrt() / self.settings.eps_t
+            })
+            .fold(0.0, f64::max)
+    }
+
+    /// Whether another Uzawa update is due (augmented Lagrangian, penetration or
+    /// elastic slip of a sticking node above the tolerance, updates left).
     pub fn needs_augmentation(&self) -> bool {
+        let tol = self.settings.penetration_tolerance;
         self.settings.enforcement == Enforcement::AugmentedLagrangian
-            && self.max_penetration() > self.settings.penetration_tolerance
+            && (self.max_penetration() > tol || self.max_elastic_slip() > tol)
             && self.augmentations < self.settings.max_augmentations
     }
 
-    /// Uzawa update λ_N ← t_N = min(0, λ_N + ε_N g_N) (sec. 4).
+    /// Uzawa update (sec. 4): λ_N ← t_N = min(0, λ_N + ε_N g_N); with friction the
+    /// tangential multiplier too (eq. 4.7's Δλ_T): a sticking node keeps its anchor ξ̄_n
+    /// and takes t_{T,n} ← t_T, so the next solve drives its elastic slip to zero; a
+    /// sliding node's slip is plastic: it is re-anchored, ξ̄_n ← ξ̄, t_{T,n} ← t_T.
     pub fn augment(&mut self) {
         self.lambda_n.copy_from_slice(&self.t_n);
+        if self.settings.frictional() {
+            for s in 0..self.slaves.len() {
+                if self.status[s] != SlaveStatus::Active {
+                    continue;
+                }
+                self.t_t_n[s] = self.t_t[s];
+                if self.slipping[s] {
+                    self.xi_n[s] = self.projections[s].xi;
+                }
+            }
+        }
         self.augmentations += 1;
     }
 
@@ -408,12 +441,14 @@ impl PairSolver {
             self.t_t_n[s] = if self.status[s] == SlaveStatus::Active { self.t_t[s] } else { [0.0; 2] };
         }
         self.xi_n_committed.copy_from_slice(&self.xi_n);
+        self.t_t_n_committed.copy_from_slice(&self.t_t_n);
     }
 
     /// The increment failed: back to the last converged multipliers.
     pub fn restore(&mut self) {
         self.lambda_n.copy_from_slice(&self.lambda_committed);
         self.xi_n.copy_from_slice(&self.xi_n_committed);
+        self.t_t_n.copy_from_slice(&self.t_t_n_committed);
         self.augmentations = 0;
     }
 

@@ -87,6 +87,11 @@ pub struct FrictionSummary {
     pub tangential_force: [f64; 3],
     pub stick: u32,
     pub slip: u32,
+    /// Largest elastic slip ‖t_T − t_{T,n}‖/ε_T of a sticking node (the penalty's
+    /// tangential constraint violation; the augmented Lagrangian drives it below the
+    /// tolerance).
+    #[serde(default)]
+    pub elastic_slip: f64,
 }
 
 /// Columns of the per-slave-node friction array `inc/<k>/pair/<p>/friction`

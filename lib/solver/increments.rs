@@ -88,12 +88,13 @@ fn contact_results(newton: &Newton) -> (Vec<PairSummary>, Vec<Vec<[f64; 6]>>, Ve
             active: c.n_active() as u32,
             max_penetration,
             augmentations: c.augmentations,
-            penetration_converged: c.settings.enforcement == Enforcement::Penalty || max_penetration <= c.settings.penetration_tolerance,
+            penetration_converged: c.settings.enforcement == Enforcement::Penalty
+                || (max_penetration <= c.settings.penetration_tolerance && c.max_elastic_slip() <= c.settings.penetration_tolerance),
             unprojected: c.failed_projections().0 as u32,
             friction: c.settings.frictional().then(|| {
                 let t = c.tangential_force();
                 let (stick, slip) = c.n_stick_slip();
-                FrictionSummary { tangential_force: [t[0], t[1], t[2]], stick: stick as u32, slip: slip as u32 }
+                FrictionSummary { tangential_force: [t[0], t[1], t[2]], stick: stick as u32, slip: slip as u32, elastic_slip: c.max_elastic_slip() }
             }),
         });
         friction.push(if c.settings.frictional() {

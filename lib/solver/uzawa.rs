@@ -29,12 +29,14 @@ pub fn solve_augmented(newton: &mut Newton, lambda: f64, u: &mut [f64], on_itera
             })?;
             if pair.needs_augmentation() {
                 note(&format!(
-                    "pair '{}': largest penetration {:.3e} > tolerance {:.3e}, {} active nodes: augmentation {} (λ_N ← t_N)",
+                    "pair '{}': largest penetration {:.3e}{} (tolerance {:.3e}), {} active nodes: augmentation {} (λ_N ← t_N{})",
                     pair.name,
                     pair.max_penetration(),
+                    if pair.settings.frictional() { format!(", elastic slip {:.3e}", pair.max_elastic_slip()) } else { String::new() },
                     pair.settings.penetration_tolerance,
                     pair.n_active(),
-                    pair.augmentations + 1
+                    pair.augmentations + 1,
+                    if pair.settings.frictional() { ", t_T,n ← t_T" } else { "" }
                 ));
                 pair.augment();
                 due = true;

@@ -19,11 +19,15 @@ const UX: f64 = 1.0e-2;
 /// (2 × 2 × 1); base clamped; the upper top driven: u_z = −DZ on t ∈ [0, 1], then
 /// u_x = +UX on [1, 2] and back to −UX on [2, 4] (load curves), u_y = 0.
 fn setup() -> String {
+    setup_with(EPS_N, EPS_T, UX)
+}
+
+fn setup_with(eps_n: f64, eps_t: f64, ux: f64) -> String {
     format!(
         "materials:\n  - {{body: lower, model: neo_hookean, E: {E:e}, nu: 0.3}}\n  - {{body: upper, model: neo_hookean, E: {E:e}, nu: 0.3}}\n\
          curves:\n  - {{name: press, points: [[0, 0], [1, 1]]}}\n  - {{name: push, points: [[1, 0], [2, 1], [4, -1]]}}\n\
-         constraints:\n  - {{set: lower_z0, fix: [x, y, z]}}\n  - {{set: upper_z1, displacement: {{z: {}}}, curve: press, fix: [y]}}\n  - {{set: upper_z1, displacement: {{x: {UX:e}}}, curve: push}}\n\
-         contact:\n  - {{pair: c, eps_n: {EPS_N:e}, enforcement: penalty, mu: {MU}, eps_t: {EPS_T:e}}}\n\
+         constraints:\n  - {{set: lower_z0, fix: [x, y, z]}}\n  - {{set: upper_z1, displacement: {{z: {}}}, curve: press, fix: [y]}}\n  - {{set: upper_z1, displacement: {{x: {ux:e}}}, curve: push}}\n\
+         contact:\n  - {{pair: c, eps_n: {eps_n:e}, enforcement: penalty, mu: {MU}, eps_t: {eps_t:e}}}\n\
          increments: {{count: 40, end: 4.0}}\n",
         -DZ
     )
@@ -78,4 +82,44 @@ fn stick_slip_and_reversal_follow_the_coulomb_law() {
         // 1 % of μN: the blocks' elastic shear and compression (E / ε_T·h ≈ 1e3)
         assert!(worst < 1e-2, "{kind:?}: tangential force off the Coulomb law by {worst:e} μN");
     }
+}
+
+/// Tangential augmentation: the same path (push to 2e-3) with the augmented
+/// Lagrangian (tolerance 1e-7 on penetration and on elastic slip), penalties
+/// ε_N = ε_T = 1e8 — above the blocks' stiffness, so each Uzawa update contracts the
+/// violation by ~1/5 (a penalty 1000× softer than the body would need thousands).
+/// While the block sticks, the penalty run's elastic slip (= H / (ε_T A)) is driven
+/// below 1e-7 by Uzawa updates of t_{T,n}; sliding keeps every node at μ|t_N|.
+#[test]
+fn augmented_lagrangian_removes_the_elastic_slip() {
+    let mesh = two_bodies("lower", &block([2, 2, 1], [1.0, 1.0, 0.5], 0.0), "upper", &block([2, 2, 1], [0.5, 0.5, 0.25], 0.0), [0.25, 0.25, 0.5]);
+    let base = setup_with(1.0e8, 1.0e8, 2.0e-3);
+    let yaml = base.replace("enforcement: penalty", "enforcement: augmented_lagrangian, penetration_tolerance: 1.0e-7, max_augmentations: 30");
+    let penalty = run_contact(&mesh, &[pair(MasterKind::Bspline, Some([3, 3]), "upper_z0", "lower_z1")], &base);
+    let r = run_contact(&mesh, &[pair(MasterKind::Bspline, Some([3, 3]), "upper_z0", "lower_z1")], &yaml);
+    let (mut stick_al, mut slip_al) = (0, 0);
+    for (inc, pen) in r.increments.iter().zip(&penalty.increments) {
+        let (s, sp) = (&inc.info.contact[0], &pen.info.contact[0]);
+        let (fr, frp) = (s.friction.as_ref().unwrap(), sp.friction.as_ref().unwrap());
+        eprintln!("t = {:.2}: elastic slip AL {:.2e} (penalty {:.2e}), stick {} slip {}, augmentations {}", inc.info.load_factor, fr.elastic_slip, frp.elastic_slip, fr.stick, fr.slip, s.augmentations);
+        assert!(s.penetration_converged && s.max_penetration <= 1e-7 && fr.elastic_slip <= 1e-7, "t = {}: {s:?}", inc.info.load_factor);
+        if fr.stick > 0 && inc.info.load_factor > 1.0 {
+            stick_al += 1;
+            assert!(s.augmentations >= 1);
+        }
+        if fr.slip > 0 && fr.stick == 0 {
+            // the whole block slides (pressing alone makes the corners slip: Poisson)
+            slip_al += 1;
+            let tang = fr.tangential_force;
+            let tn = (tang[0].powi(2) + tang[1].powi(2) + tang[2].powi(2)).sqrt();
+            let n = s.force[2] - tang[2];
+            // every node at μ|t_N|; their directions differ slightly (the stiff
+            // penalties let the blocks' shear show), so the resultant is a bit below μN
+            assert!(tn <= MU * n * (1.0 + 1e-9) && tn > 0.99 * MU * n, "|T| = {tn}, μN = {}", MU * n);
+        }
+    }
+    // the penalty run's elastic slip reaches μ t_N / ε_T before sliding
+    let max_penalty = penalty.increments.iter().map(|i| i.info.contact[0].friction.as_ref().unwrap().elastic_slip).fold(0.0, f64::max);
+    assert!(max_penalty > 1e-5, "penalty elastic slip {max_penalty:e}");
+    assert!(stick_al >= 10 && slip_al >= 1, "{stick_al} stick, {slip_al} slip increments");
 }
