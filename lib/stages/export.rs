@@ -92,6 +92,8 @@ pub fn write_results_pvd(results: &Results, output: &Path) -> Result<String, Sta
         contact: vec![],
         friction: vec![],
     };
+    // friction fields in every step when any increment carries them
+    let frictional = results.increments.iter().any(|i| i.friction.iter().any(|f| !f.is_empty()));
     for (k, inc) in std::iter::once(&zero).chain(results.increments.iter()).enumerate() {
         let name = format!("{stem}_{k}.vtu");
         let mut g = vtk::mesh_grid(mesh);
@@ -102,6 +104,9 @@ pub fn write_results_pvd(results: &Results, output: &Path) -> Result<String, Sta
         push_stress_fields(&mut g.cell_data, &elem);
         if !results.pairs.is_empty() {
             push_contact_fields(&mut g.point_data, mesh.nodes.len(), results, &inc.contact);
+            if frictional {
+                push_friction_fields(&mut g.point_data, mesh.nodes.len(), results, &inc.friction);
+            }
         }
         g.write_vtu(&dir.join(&name))?;
         entries.push((inc.info.load_factor, name));
@@ -139,6 +144,36 @@ fn push_contact_fields(out: &mut Vec<vtk::Field>, n: usize, results: &Results, s
     out.push(vtk::Field::scalar_f64("contact_gap", gap));
     out.push(vtk::Field::scalar_f64("contact_lambda_n", lambda));
     out.push(vtk::Field::scalar_f64("contact_status", status));
+}
+
+/// Friction point data on the slave nodes ([`scres::FRICTION_COLUMNS`]):
+/// `contact_tangential_traction` t_T (the traction the slave exerts on the master;
+/// the master holds the slave back with −t_T), `contact_slip` (ξ̄ − ξ̄_n)^α ā_α of the
+/// increment, `contact_stick_slip` (0 not active, 1 stick, 2 slip, −2 not a slave
+/// node of a frictional pair).
+fn push_friction_fields(out: &mut Vec<vtk::Field>, n: usize, results: &Results, friction: &[Vec<[f64; 9]>]) {
+    let mut traction = vec![0.0; 3 * n];
+    let mut slip = vec![0.0; 3 * n];
+    let mut state = vec![-2.0; n];
+    for (p, pair) in results.pairs.iter().enumerate() {
+        let rows = friction.get(p).filter(|f| !f.is_empty());
+        for (s, &node) in pair.slave_nodes.iter().enumerate() {
+            let i = node as usize;
+            match rows.and_then(|r| r.get(s)) {
+                Some(row) => {
+                    for c in 0..3 {
+                        traction[3 * i + c] += row[c];
+                        slip[3 * i + c] = row[3 + c];
+                    }
+                    state[i] = row[8];
+                }
+                None => state[i] = state[i].max(0.0),
+            }
+        }
+    }
+    out.push(vtk::Field::vector_f64("contact_tangential_traction", traction));
+    out.push(vtk::Field::vector_f64("contact_slip", slip));
+    out.push(vtk::Field::scalar_f64("contact_stick_slip", state));
 }
 
 /// Sub-quads per knot span (B-spline) or facet, per direction, in the tessellated

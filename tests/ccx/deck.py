@@ -16,10 +16,11 @@ Usage (from the repository root):
     .venv/bin/python tests/ccx/deck.py pipelines/curved.yaml --solve 1 --run --json
     .venv/bin/python tests/ccx/deck.py pipelines/cantilever.yaml --run --compare
 Options: --out DIR (default: <pipeline folder>/out/ccx), --solve N (which solve
-stage, 0-based, default 0), --slope K (contact penalty slope for every pair; default
+stage, 0-based, default 0), --msh FILE (instead of the pipeline's mesh), --slope K (contact penalty slope for every pair; default
 eps_n for penalty, 100 x eps_n for augmented_lagrangian), --tension S (ccx sigma_inf,
 1e-6), --ran R (*CONTROLS FIELD R_n = C_n, default the setup's
-newton.residual_tolerance), --direct (fixed increments, no ccx cutbacks), --compare
+newton.residual_tolerance), --direct (fixed increments, no ccx cutbacks), --contact
+node|surface (NODE TO SURFACE, default, or SURFACE TO SURFACE), --compare
 [PVD|VTU] (our result at the last increment; without a file, the .pvd the pipeline
 exports from this solve), --ccx PATH, --json.
 
@@ -67,6 +68,24 @@ class DeckError(Exception):
     pass
 
 
+class Yaml12Loader(yaml.SafeLoader):
+    """PyYAML reads YAML 1.1, where 1.0e9 (no sign in the exponent) is a string;
+    serde_yaml (ours) reads it as a number.  Resolve floats the YAML 1.2 way."""
+
+
+Yaml12Loader.yaml_implicit_resolvers = {k: [r for r in v if r[0] != "tag:yaml.org,2002:float"]
+                                        for k, v in yaml.SafeLoader.yaml_implicit_resolvers.items()}
+Yaml12Loader.add_implicit_resolver(
+    "tag:yaml.org,2002:float",
+    re.compile(r"""^(?:[-+]?(?:\.[0-9]+|[0-9]+(?:\.[0-9]*)?)(?:[eE][-+]?[0-9]+)?
+                 |[-+]?\.(?:inf|Inf|INF)|\.(?:nan|NaN|NAN))$""", re.X),
+    list("-+0123456789."))
+
+
+def load_yaml(text):
+    return yaml.load(text, Loader=Yaml12Loader)
+
+
 def fmt(x):
     """A float field ccx reads with (f20.0): at most 20 characters."""
     s = repr(float(x))
@@ -97,11 +116,11 @@ def stage_list(pipe):
     return out
 
 
-def resolve_pipeline(path, solve_index=0):
+def resolve_pipeline(path, solve_index=0, msh_override=None):
     """(pipeline, solve stage, setup, msh path, contact pairs, pvd of our result)."""
     path = Path(path).resolve()
     base = path.parent
-    pipe = yaml.safe_load(path.read_text())
+    pipe = load_yaml(path.read_text())
     stages = stage_list(pipe)
     rel = lambda p: (base / p).resolve()
     solves = [b for k, b in stages if k == "solve"]
@@ -112,7 +131,7 @@ def resolve_pipeline(path, solve_index=0):
     solve = solves[solve_index]
     if ("setup" in solve) == ("setup_file" in solve):
         raise DeckError("solve stage %d: give exactly one of setup, setup_file" % solve_index)
-    setup = solve["setup"] if "setup" in solve else yaml.safe_load(rel(solve["setup_file"]).read_text())
+    setup = solve["setup"] if "setup" in solve else load_yaml(rel(solve["setup_file"]).read_text())
     producers = {rel(b["output"]): (k, b) for k, b in stages if "output" in b}
     src = rel(solve["input"])
     pairs = []
@@ -125,7 +144,7 @@ def resolve_pipeline(path, solve_index=0):
     k, imp = producers.get(src, (None, None))
     if k != "import":
         raise DeckError("no import stage writes %s" % shown(src))
-    msh = rel(imp["input"])
+    msh = Path(msh_override).resolve() if msh_override else rel(imp["input"])
     if not msh.exists():
         k, _ = producers.get(msh, (None, None))
         hint = " (it is written by the pipeline's %s stage: run the pipeline first)" % k if k else ""
@@ -310,7 +329,7 @@ def ids_lines(ids, per=8):
 
 
 # ---------------------------------------------------------------------- deck
-def build_deck(P, mesh, slope_override=None, tension=DEFAULT_TENSION, ran=None, direct=False):
+def build_deck(P, mesh, slope_override=None, tension=DEFAULT_TENSION, ran=None, direct=False, ctype="node"):
     """The deck text and a description of the model (for running and parsing)."""
     setup = P["setup"]
     names = Names()
@@ -374,7 +393,7 @@ def build_deck(P, mesh, slope_override=None, tension=DEFAULT_TENSION, ran=None, 
         mat_lines += ["*SOLID SECTION, ELSET=%s, MATERIAL=%s" % (eset, mname)]
 
     # ---- amplitudes: a(t) over the load factor t = ccx total time
-    amp_lines, amp_used = [], {}
+    amp_lines, amp_used, amp_tables = [], {}, {}
 
     def amplitude(curve):
         if curve is None:
@@ -392,6 +411,7 @@ def build_deck(P, mesh, slope_override=None, tension=DEFAULT_TENSION, ran=None, 
         if key not in amp_used:
             an = names.get("A_", key)
             amp_used[key] = an
+            amp_tables[an] = pts
             amp_lines.append("*AMPLITUDE, NAME=%s, TIME=TOTAL TIME" % an)
             amp_lines.extend("%s, %s" % (fmt(t), fmt(a)) for t, a in pts)
         return amp_used[key]
@@ -443,7 +463,7 @@ def build_deck(P, mesh, slope_override=None, tension=DEFAULT_TENSION, ran=None, 
                         lines += ["%d, %d, %d, %s" % (n, d, d, fmt(v)) for n in owned]
 
     # ---- loads
-    cload, dload, load_desc = {}, {}, []
+    cload, dload, dload_nodes, load_desc = {}, {}, {}, []
     for li, l in enumerate(setup.get("loads", [])):
         if l.get("set") is not None and l.get("force") is not None:
             nodes = nset(l["set"])
@@ -460,7 +480,8 @@ def build_deck(P, mesh, slope_override=None, tension=DEFAULT_TENSION, ran=None, 
         elif l.get("face_set") is not None and l.get("pressure") is not None:
             amp = amplitude(l.get("curve"))
             faces = fset(l["face_set"])
-            for e, f, _ in faces:
+            for e, f, fn in faces:
+                dload_nodes[(e, f)] = fn
                 dload.setdefault((e, f), {}).setdefault(amp, 0.0)
                 dload[(e, f)][amp] += float(l["pressure"])
             load_desc.append("load %d: pressure %s on %s (%d faces) -> *DLOAD Pn (follower under NLGEOM), amplitude %s"
@@ -497,7 +518,7 @@ def build_deck(P, mesh, slope_override=None, tension=DEFAULT_TENSION, ran=None, 
         else:
             slave_nodes = nset(p["slave"])
             contact_lines.append("*SURFACE, NAME=%s, TYPE=NODE" % sname)
-            contact_lines += ids_lines(slave_nodes)
+            contact_lines += [str(n) for n in slave_nodes]  # one node per line (ccx)
             # ours: A_s = 1 (eps_n is force per penetration per node); ccx: a node of no
             # slave face gets the area of the master face it hits -> divide by the mean.
             a_m = float(np.mean([quad_area(np.array([xyz[n] for n in fn])) for _, _, fn in master]))
@@ -523,9 +544,14 @@ def build_deck(P, mesh, slope_override=None, tension=DEFAULT_TENSION, ran=None, 
             kt = float(c["eps_t"]) * slope_scale
             contact_lines += ["*FRICTION", "%s, %s" % (fmt(mu), fmt(kt))]
             fric = "; *FRICTION mu = %s, stick slope = eps_t = %s (times the slave area, as ours)" % (fmt(mu), fmt(kt))
-        contact_lines += ["*CONTACT PAIR, INTERACTION=%s, TYPE=NODE TO SURFACE" % iname, "%s, %s" % (sname, mname)]
+        if ctype == "surface" and slave_faces is None:
+            raise DeckError("pair %s: SURFACE TO SURFACE needs a face-set slave" % p["name"])
+        contact_lines += ["*CONTACT PAIR, INTERACTION=%s, TYPE=%s" % (iname, "NODE TO SURFACE" if ctype == "node" else "SURFACE TO SURFACE"),
+                          "%s, %s" % (sname, mname)]
         kind = p.get("master_kind", "bspline")
         contact_desc.append(
+            ("" if ctype == "node" else "SURFACE TO SURFACE (--contact surface: ccx face-to-face penalty, pressure at the"
+             " slave faces' integration points, not per node as ours); ") +
             "pair %s: slave %s (%d nodes), master %s (%d faces; ours %s%s -> ccx bilinear facets of the same faces);"
             " %s eps_n = %s -> PRESSURE-OVERCLOSURE=LINEAR slope %s (%s), sigma_inf %s; %s%s"
             % (p["name"], p["slave"], len(slave_nodes), p["master"], len(master), kind,
@@ -537,6 +563,7 @@ def build_deck(P, mesh, slope_override=None, tension=DEFAULT_TENSION, ran=None, 
             notes.append("pair %s: augmented Lagrangian -> penalty slope %s (penetration ~ p/K)" % (p["name"], fmt(K)))
         pairs_out.append(dict(name=p["name"], slave_nodes=slave_nodes,
                               slave_faces=[fn for _, _, fn in slave_faces] if slave_faces is not None else None,
+                              slave_elems=[e for e, _, _ in slave_faces] if slave_faces is not None else [],
                               slope=K))
 
     # ---- steps: t = ccx total time; count -> one step, factors -> one step per factor
@@ -553,7 +580,7 @@ def build_deck(P, mesh, slope_override=None, tension=DEFAULT_TENSION, ran=None, 
     # ---- write
     src_msh = shown(P["msh"])
     w("** GENERATED by tests/ccx/deck.py from %s -- do not edit;" % shown(P["pipeline"]))
-    w("** regenerate: .venv/bin/python tests/ccx/deck.py %s --solve %d" % (shown(P["pipeline"]), P["solve_index"]))
+    w("** regenerate: .venv/bin/python tests/ccx/deck.py %s%s" % (shown(P["pipeline"]), P.get("options", "")))
     w("** solve stage %d of %d (output %s), mesh %s." % (P["solve_index"], P["n_solves"], P["solve"]["output"], src_msh))
     w("** Mapping of our setup (ccx 2.20):")
     w("** - mesh: C3D8 (full integration hex8, like ours); ccx node/element numbers = gmsh")
@@ -642,8 +669,10 @@ def build_deck(P, mesh, slope_override=None, tension=DEFAULT_TENSION, ran=None, 
 
     for k, (dt, period) in enumerate(steps):
         step_body(k == 0, dt, period)
+    set_nodes = {sn: node_sets[s] for s, sn in reaction_sets}
     model = dict(name=P["name"], factors=factors, reaction_sets=reaction_sets, pairs=pairs_out,
-                 notes=notes, used=mesh["used"], xyz=xyz, n_steps=len(steps), nlgeom=nlgeom)
+                 cload=cload, dload=dload, dload_nodes=dload_nodes, amp_tables=amp_tables, set_nodes=set_nodes,
+                 notes=notes, used=mesh["used"], xyz=xyz, n_steps=len(steps), nlgeom=nlgeom, ctype=ctype)
     return "\n".join(L) + "\n", model
 
 
@@ -674,8 +703,9 @@ def parse_sta(text):
     for line in text.splitlines():
         t = line.split()
         if len(t) >= 7 and t[0].isdigit() and t[1].isdigit():
+            # ATT ends in U for an attempt that did not converge (then cut back)
             rows.append(dict(step=int(t[0]), inc=int(t[1]), attempts=int(re.sub(r"\D", "", t[2]) or 0),
-                             iterations=int(t[3]), time=float(t[5])))
+                             converged=not t[2].endswith("U"), iterations=int(t[3]), time=float(t[4])))
     return rows
 
 
@@ -686,6 +716,51 @@ def parse_cvg(text):
         if len(t) >= 8 and all(re.fullmatch(NUM, x) for x in t[:8]):
             rows.append([float(x) for x in t[:8]])
     return rows
+
+
+def amp_at(pts, t):
+    """Piecewise linear through pts, constant beyond the ends (ours and ccx)."""
+    if t <= pts[0][0]:
+        return pts[0][1]
+    for (t0, a0), (t1, a1) in zip(pts, pts[1:]):
+        if t <= t1:
+            return a0 + (a1 - a0) * (t - t0) / (t1 - t0)
+    return pts[-1][1]
+
+
+def pressure_forces(x, p):
+    """Consistent nodal forces of a pressure p on a bilinear quad x (4x3, outward
+    order): f_a = -p * integral N_a n dA (2x2 Gauss is exact here)."""
+    f, g = np.zeros((4, 3)), 1.0 / math.sqrt(3.0)
+    for xi in (-g, g):
+        for et in (-g, g):
+            N = 0.25 * np.array([(1 - xi) * (1 - et), (1 + xi) * (1 - et), (1 + xi) * (1 + et), (1 - xi) * (1 + et)])
+            dxi = 0.25 * (-(1 - et) * x[0] + (1 - et) * x[1] + (1 + et) * x[2] - (1 + et) * x[3])
+            det = 0.25 * (-(1 - xi) * x[0] - (1 + xi) * x[1] + (1 + xi) * x[2] + (1 - xi) * x[3])
+            f -= p * np.outer(N, np.cross(dxi, det))
+    return f
+
+
+def applied(model, set_name, t, U):
+    """Sum of the applied forces on a node set at time t: the *CLOADs, and the
+    *DLOAD pressures' nodal forces on the faces' current positions X + U."""
+    f = np.zeros(3)
+    nodes = set(model["set_nodes"][set_name])
+    for (n, d), by_amp in model["cload"].items():
+        if n in nodes:
+            for amp, v in by_amp.items():
+                f[d - 1] += v * amp_at(model["amp_tables"][amp], t)
+    for (e, face), by_amp in model["dload"].items():
+        fn = model["dload_nodes"][(e, face)]
+        if nodes.isdisjoint(fn):
+            continue
+        x = np.array([model["xyz"][n] + (U.get(n, 0.0) if model["nlgeom"] else 0.0) for n in fn])
+        for amp, v in by_amp.items():
+            fa = pressure_forces(x, v * amp_at(model["amp_tables"][amp], t))
+            for k, n in enumerate(fn):
+                if n in nodes:
+                    f += fa[k]
+    return f
 
 
 def run_ccx(deck, model, out, ccx):
@@ -704,7 +779,7 @@ def run_ccx(deck, model, out, ccx):
     dat, sta, cvg = rd(".dat"), rd(".sta"), rd(".cvg")
     blocks = parse_dat(dat)
     m = re.search(r"Version\s+([0-9][0-9.]*[0-9])", log)
-    res = dict(pipeline=None, deck=str(out / (name + ".inp")), ccx_version=m.group(1) if m else "?",
+    res = dict(pipeline=None, deck=shown(out / (name + ".inp")), ccx_version=m.group(1) if m else "?",
                ok=ok, wall_seconds=round(wall, 3), notes=model["notes"])
     if not ok:
         err = [l for l in log.splitlines() if "ERROR" in l or "error" in l]
@@ -718,17 +793,34 @@ def run_ccx(deck, model, out, ccx):
             if mset and rows:
                 rf.setdefault(t, {})[mset.group(1).upper()] = rows[-1][-3:]
     sta_rows = parse_sta(sta)
-    by_time = {round(r["time"], 12): r for r in sta_rows}
+
+    def reaction(total_rf, sn, t, U):
+        # ccx RF is the internal nodal force: at a loaded free dof it equals the load.
+        # Subtract the applied loads so that the figure is the support reaction (ours:
+        # the residual f_int - f_ext summed over the set).
+        if total_rf is None:
+            return None
+        return [float(v) for v in np.array(total_rf) - applied(model, sn, t, U)]
+    conv = [r for r in sta_rows if r["converged"]]
+    # .sta prints 6 significant digits, .dat 7
+
+
+    def sta_row(t):
+        near = [r for r in conv if abs(r["time"] - t) <= 1e-5 * abs(t)]
+        return near[0] if near else {}
+
     incs = []
     for t, rows in disp:
         u = np.array([r[1:4] for r in rows])
         mag = np.linalg.norm(u, axis=1)
         i = int(np.argmax(mag))
-        s = by_time.get(round(t, 12), {})
+        s = sta_row(t)
         incs.append(dict(time=t, max_u=float(mag[i]), max_u_node=int(rows[i][0]),
                          u_at_max=[float(v) for v in u[i]],
-                         attempts=s.get("attempts"), iterations=s.get("iterations"),
-                         reactions={sname: rf.get(t, {}).get(sn.upper()) for sname, sn in model["reaction_sets"]}))
+                         converged=bool(s), attempts=s.get("attempts"), iterations=s.get("iterations"),
+                         reactions={sname: reaction(rf.get(t, {}).get(sn.upper()), sn, t,
+                                                    {int(r[0]): np.array(r[1:4]) for r in rows})
+                                    for sname, sn in model["reaction_sets"]}))
     res["increments"] = incs
     res["target_factors"] = model["factors"]
     res["cvg_iterations_total"] = len(parse_cvg(cvg))
@@ -743,26 +835,33 @@ def run_ccx(deck, model, out, ccx):
                 wr.writerow([n] + ["%.7e" % v for v in U[n]])
         res["final"] = dict(time=t, reached_end=abs(t - model["factors"][-1]) < 1e-9 * max(1.0, abs(t)),
                             max_u=incs[-1]["max_u"], max_u_node=incs[-1]["max_u_node"],
-                            u_at_max=incs[-1]["u_at_max"], reactions=incs[-1]["reactions"], u_csv=str(csv_path))
-        # contact at the last increment: CSTR rows (node, p, t1, t2) of the last block
+                            u_at_max=incs[-1]["u_at_max"], reactions=incs[-1]["reactions"], u_csv=shown(csv_path))
+        # contact at the last increment: CSTR rows of the last block, per slave node
+        # (node, p, t1, t2) for NODE TO SURFACE, per slave face integration point
+        # (element, face, p, t1, t2) for SURFACE TO SURFACE
         cst = [(s, tt, r) for s, tt, r in blocks if s.startswith("contact stress") and tt == t]
         if model["pairs"] and cst:
-            press = {}
-            for r in cst[-1][2]:
-                press[int(r[0])] = r[1]
+            rows = cst[-1][2]
             res["contact"] = {}
             for p in model["pairs"]:
-                ps = {n: press[n] for n in p["slave_nodes"] if n in press}
-                info = dict(slope=p["slope"], slave_nodes=len(p["slave_nodes"]),
-                            active=sum(1 for v in ps.values() if v > 0),
-                            max_pressure=max(ps.values()) if ps else 0.0)
-                if p["slave_faces"] is not None:
-                    area = {}
-                    for fn in p["slave_faces"]:
-                        a = quad_area(np.array([model["xyz"][n] + U.get(n, 0.0) for n in fn]))
-                        for n in fn:
-                            area[n] = area.get(n, 0.0) + a / 4
-                    info["normal_force_total"] = sum(v * area[n] for n, v in ps.items() if v > 0)
+                info = dict(slope=p["slope"], slave_nodes=len(p["slave_nodes"]))
+                if model["ctype"] == "node":
+                    ps = {int(r[0]): r[1] for r in rows if int(r[0]) in set(p["slave_nodes"])}
+                    info.update(active=sum(1 for v in ps.values() if v > 0),
+                                max_pressure=max(ps.values()) if ps else 0.0)
+                    if p["slave_faces"] is not None:
+                        area = {}
+                        for fn in p["slave_faces"]:
+                            a = quad_area(np.array([model["xyz"][n] + U.get(n, 0.0) for n in fn]))
+                            for n in fn:
+                                area[n] = area.get(n, 0.0) + a / 4
+                        # sum of p_i A_i with ccx's (deformed) tributary areas
+                        info["normal_force_total"] = float(sum(v * area[n] for n, v in ps.items() if v > 0))
+                else:
+                    elems = set(p["slave_elems"])
+                    ps = [r[2] for r in rows if len(r) >= 5 and int(r[0]) in elems]
+                    info.update(integration_points_active=sum(1 for v in ps if v > 0),
+                                max_pressure=max(ps) if ps else 0.0)
                 res["contact"][p["name"]] = info
     return res
 
@@ -810,19 +909,25 @@ def main(argv=None):
     ap.add_argument("--out", default=None, help="output folder (default <pipeline folder>/out/ccx)")
     ap.add_argument("--solve", type=int, default=0, help="which solve stage (0-based)")
     ap.add_argument("--run", action="store_true")
+    ap.add_argument("--msh", default=None, help="use this .msh instead of the pipeline's (e.g. one a gmsh stage would write)")
     ap.add_argument("--slope", type=float, default=None)
     ap.add_argument("--tension", type=float, default=DEFAULT_TENSION)
     ap.add_argument("--ran", type=float, default=None)
     ap.add_argument("--direct", action="store_true")
+    ap.add_argument("--contact", choices=["node", "surface"], default="node",
+                    help="ccx contact type: NODE TO SURFACE (like ours, default) or SURFACE TO SURFACE")
     ap.add_argument("--compare", nargs="?", const="auto", default=None)
     ap.add_argument("--ccx", default=shutil.which("ccx") or "/usr/bin/ccx")
     ap.add_argument("--json", action="store_true")
     a = ap.parse_args(argv)
     try:
-        P = resolve_pipeline(a.pipeline, a.solve)
+        P = resolve_pipeline(a.pipeline, a.solve, a.msh)
+        opts = [("--solve", a.solve, 0), ("--msh", a.msh and shown(a.msh), None), ("--slope", a.slope, None),
+                ("--tension", a.tension, DEFAULT_TENSION), ("--ran", a.ran, None), ("--contact", a.contact, "node")]
+        P["options"] = "".join(" %s %s" % (k, v) for k, v, d in opts if v != d) + (" --direct" if a.direct else "")
         out = Path(a.out) if a.out else P["pipeline"].parent / "out" / "ccx"
         mesh = read_mesh(P["msh"])
-        deck, model = build_deck(P, mesh, a.slope, a.tension, a.ran, a.direct)
+        deck, model = build_deck(P, mesh, a.slope, a.tension, a.ran, a.direct, a.contact)
     except (DeckError, KeyError, TypeError) as e:
         sys.exit("deck.py: %s: %s" % (a.pipeline, e if isinstance(e, DeckError) else "bad pipeline/setup: %r" % (e,)))
     out.mkdir(parents=True, exist_ok=True)
@@ -839,7 +944,7 @@ def main(argv=None):
         if ours is None or not Path(ours).exists():
             res["compare"] = "no result of ours found (%s): run the pipeline first" % (shown(ours) if ours else "no export stage")
         else:
-            res["compare"] = compare(res, res["final"]["u_csv"], ours)
+            res["compare"] = compare(res, out / (P["name"] + "_u.csv"), ours)
     (out / (P["name"] + ".json")).write_text(json.dumps(res, indent=1) + "\n")
     if a.json:
         print(json.dumps(res, indent=1))

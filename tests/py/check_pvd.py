@@ -5,7 +5,9 @@ Parses the collection, reads every .vtu it lists with meshio and asserts the fie
 ParaView users rely on: point data displacement (n,3), stress (n,9), von_mises,
 principal_max >= principal_min; cell data body and stress. When the results carry
 contact (point data contact_status), every step must have the four contact fields,
-pressure >= 0, pressure only where status = 1, status in {-2, -1, 0, 1}. Prints one
+pressure >= 0, pressure only where status = 1, status in {-2, -1, 0, 1}; with
+friction (contact_stick_slip) also the traction and slip vectors, stick/slip only on
+active nodes, no traction elsewhere. Prints one
 JSON line with the number of steps, the time values and max |u| of the last step per
 component, and for contact the last step's slave pressures (status >= -1), active
 count and min/max gap.
@@ -52,7 +54,17 @@ def main():
             assert np.all(p >= 0.0), f"{f}: negative contact pressure"
             assert np.all(p[st != 1.0] == 0.0), f"{f}: pressure on a node that is not active"
             slave = st >= -1.0
+            friction = None
+            if "contact_stick_slip" in m.point_data:
+                ss = np.asarray(m.point_data["contact_stick_slip"]).ravel()
+                tt = np.asarray(m.point_data["contact_tangential_traction"])
+                assert tt.shape == (n, 3) and np.asarray(m.point_data["contact_slip"]).shape == (n, 3), f"{f}: friction vector shapes"
+                assert set(np.unique(ss)) <= {-2.0, 0.0, 1.0, 2.0}, f"{f}: stick/slip values {np.unique(ss)}"
+                assert np.all(tt[ss <= 0.0] == 0.0), f"{f}: tangential traction on a node not in contact"
+                assert np.all((ss >= 1.0) <= (st == 1.0)), f"{f}: stick/slip on a node that is not active"
+                friction = {"stick": int(np.sum(ss == 1.0)), "slip": int(np.sum(ss == 2.0)), "max_traction": float(np.linalg.norm(tt, axis=1).max())}
             contact = {
+                "friction": friction,
                 "slave_pressures": p[slave].tolist(),
                 "active": int(np.sum(st == 1.0)),
                 "gap_min": float(np.nanmin(fields["contact_gap"][slave])) if t > 0 else None,

@@ -123,3 +123,25 @@ fn augmented_lagrangian_removes_the_elastic_slip() {
     assert!(max_penalty > 1e-5, "penalty elastic slip {max_penalty:e}");
     assert!(stick_al >= 10 && slip_al >= 1, "{stick_al} stick, {slip_al} slip increments");
 }
+
+/// What ParaView shows: the frictional results exported as a .pvd carry the
+/// tangential traction, slip and stick/slip state on the slave nodes (meshio reads
+/// them; `check_pvd.py` checks their consistency).
+#[test]
+fn friction_fields_in_the_pvd() {
+    let mesh = two_bodies("lower", &block([2, 2, 1], [1.0, 1.0, 0.5], 0.0), "upper", &block([2, 2, 1], [0.5, 0.5, 0.25], 0.0), [0.25, 0.25, 0.5]);
+    let r = run_contact(&mesh, &[pair(MasterKind::Bspline, Some([3, 3]), "upper_z0", "lower_z1")], &setup());
+    let dir = crate::common::tempdir();
+    let (res, pvd) = (dir.path().join("f.scres"), dir.path().join("f.pvd"));
+    r.write(&res).unwrap();
+    splinecontact::stages::export::export(&res, &pvd, None).unwrap();
+    let o = crate::common::python_script("check_pvd.py", &[&pvd]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{out}{}", String::from_utf8_lossy(&o.stderr));
+    let j: serde_yaml::Value = serde_yaml::from_str(out.trim()).unwrap();
+    // last step (t = 4): the block slides back, all 9 slave nodes slipping at μ t_N
+    assert_eq!(j["contact"]["friction"]["slip"].as_u64(), Some(9), "{out}");
+    let t_max = j["contact"]["friction"]["max_traction"].as_f64().unwrap();
+    let p_max = j["contact"]["slave_pressures"].as_sequence().unwrap().iter().map(|v| v.as_f64().unwrap()).fold(0.0, f64::max);
+    assert!(t_max <= MU * p_max * (1.0 + 1e-6) && t_max > 0.9 * MU * p_max, "traction {t_max} vs μ p_max {}", MU * p_max);
+}
