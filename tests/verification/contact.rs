@@ -154,7 +154,14 @@ fn augmented_lagrangian_removes_the_penalty() {
 fn assembled_contact_tangent_matches_finite_differences() {
     use splinecontact::solver::newton::Newton;
     use splinecontact::solver::problem::Problem;
-    for (kind, orders) in [(MasterKind::Facet, None), (MasterKind::Bspline, Some([2, 2])), (MasterKind::Bspline, Some([3, 3])), (MasterKind::Bspline, Some([4, 4]))] {
+    // frictionless, and with Coulomb friction: ε_T = 2 leaves the nodes sticking (their
+    // slip from the reference foot point, ~0.05, gives ε_T·slip = 0.1 < μ t_N ≈ 6),
+    // ε_T = 1e4 makes most slide (non-symmetric tangent), the central ones stick
+    let friction = [None, Some("mu: 0.3, eps_t: 2.0"), Some("mu: 0.3, eps_t: 1.0e4")];
+    for ((kind, orders), fr) in [(MasterKind::Facet, None), (MasterKind::Bspline, Some([2, 2])), (MasterKind::Bspline, Some([3, 3])), (MasterKind::Bspline, Some([4, 4]))]
+        .into_iter()
+        .flat_map(|k| friction.iter().map(move |f| (k, *f)))
+    {
         let mut mesh = stacked(4, 3);
         for (i, p) in mesh.nodes.iter_mut().enumerate() {
             // lower body's top layer: a smooth wave (a curved master); 75 lower nodes come first
@@ -163,7 +170,11 @@ fn assembled_contact_tangent_matches_finite_differences() {
             }
         }
         let model = build_model(mesh.clone(), "t", &[pair(kind, orders, "upper_z0", "lower_z1")]).unwrap();
-        let setup = SolveSetup::parse("s", &patch_setup("augmented_lagrangian", 1.0e3, 0.0)).unwrap();
+        let mut yaml = patch_setup("augmented_lagrangian", 1.0e3, 0.0);
+        if let Some(f) = fr {
+            yaml = yaml.replace("max_augmentations: 30}", &format!("max_augmentations: 30, {f}}}"));
+        }
+        let setup = SolveSetup::parse("s", &yaml).unwrap();
         let problem = Problem::with_contact(&model.mesh, &model.pairs, &setup, "s").unwrap();
         let mut newton = Newton::new(&problem, setup.newton.clone(), setup.linear_solver).unwrap();
         // the slave block shrunk by 10 % in x and y about the centre (so its edge nodes
@@ -178,6 +189,14 @@ fn assembled_contact_tangent_matches_finite_differences() {
         }
         let (_, col_ptr, row_idx, values) = newton.residual_tangent_at(&u, 1.0).unwrap();
         assert!(newton.n_contact_pressed() == 16, "{kind:?}: {} slave nodes pressed", newton.n_contact_pressed());
+        newton.contact[0].update_states().unwrap();
+        let (stick, slip) = newton.contact[0].n_stick_slip();
+        match fr {
+            // nodes near the centre move least: a few stick, most slide — both branches
+            Some(f) if f.contains("1.0e4") => assert!(slip >= 10 && stick + slip == 16, "{kind:?}: {stick} stick, {slip} slip"),
+            Some(_) => assert_eq!((stick, slip), (16, 0), "{kind:?}: all stick"),
+            None => {}
+        }
         let free: Vec<usize> = (0..3 * n).filter(|&d| problem.dofs.free(d).is_some()).collect();
         let h = 1e-7;
         let (mut err, mut norm) = (0.0f64, 0.0f64);
@@ -198,7 +217,7 @@ fn assembled_contact_tangent_matches_finite_differences() {
                 norm = norm.max(col[i].abs());
             }
         }
-        eprintln!("assembled contact tangent {kind:?} {orders:?}: max |K − K_fd| / max |K| = {:.2e}", err / norm);
+        eprintln!("assembled contact tangent {kind:?} {orders:?} {}: max |K − K_fd| / max |K| = {:.2e}", fr.unwrap_or("frictionless"), err / norm);
         // central differences, h = 1e-7 on O(1) coordinates: truncation ~h²·|r'''| and
         // round-off ~1e-16·|r|/h ≈ 1e-9 relative: 1e-6 leaves a wide margin
         assert!(err / norm < 1e-6, "{kind:?} {orders:?}: {:e}", err / norm);
