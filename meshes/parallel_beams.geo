@@ -13,18 +13,16 @@
 //   the middle (x = 70 and 80: lower beam up 0.88, upper beam down 0.44, this mesh),
 //   so the beams touch at about 40 % of the load, both already arched.
 //   15 elements of 10 along x; sections 2 x 2 (lower, elements 5 x 5) and 4 x 2
-//   (upper: element widths 5.5, 4.5, 4.5, 5.5, height 5).
+//   (upper, elements 5 x 5).
 // Load lines (ours, the paper: "4 kN on each load line", the loading under the lower
 // beam the same pattern as on top of the upper one): the transverse node lines at the
 // third points x = 50 and x = 100, on the upper beam's top (5 nodes each) and on the
 // lower beam's bottom (3 nodes each). Each beam is built from three extruded segments
 // (x = 0..50, 50..100, 100..150) so that these lines are gmsh curves.
-// The upper beam's inner node rows are at y = +-4.5, not +-5, so that no slave node
-// stands on the lower beam's long edges (the master patch's edges): with a slave on a
-// patch edge (kept in contact by the solver's edge tolerance) and friction, Newton
-// converges only linearly (rate 0.67 per iteration; the uniform +-5 mesh needs 33
-// iterations per increment). The bottom rows y = 0, +-4.5 stand on the master,
-// y = +-10 outside it.
+// The upper beam's inner node rows y = +-5 stand exactly on the lower beam's long
+// edges (the master patch's edges): the solver keeps such nodes in contact on the
+// patch's extension (edge tolerance), the rows y = 0, +-5 carry the contact, y = +-10
+// are outside the master. (Parameter yi moves the inner rows, e.g. to 4.5.)
 // Sets: lower_ends, upper_ends (x = 0 and 150 faces, clamped), lower_top (master,
 // 3 x 16 node net), upper_bottom (slave, 5 x 16 nodes), upper_load_lines (top,
 // x = 50 and 100), lower_load_lines (bottom, x = 50 and 100).
@@ -54,7 +52,7 @@ l3[] = Extrude {L/3, 0, 0} { Surface{l2[0]}; Layers{nseg}; Recombine; };
 // ---- upper beam (tags from 1000 up): the section as four columns of quads (one
 // element wide, two high), extruded together so that shared faces stay shared ----
 zu = h + gap;
-yi = 4.5;                                 // inner node rows of the upper beam at y = +-yi
+yi = 5.0;                                 // inner node rows of the upper beam at y = +-yi
 Point(1001) = {0, -bu/2, zu}; Point(1002) = {0, -yi, zu}; Point(1003) = {0, 0, zu};
 Point(1004) = {0, yi, zu}; Point(1005) = {0, bu/2, zu};
 Point(1006) = {0, -bu/2, zu + h}; Point(1007) = {0, -yi, zu + h}; Point(1008) = {0, 0, zu + h};

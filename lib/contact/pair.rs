@@ -90,6 +90,15 @@ impl Projector {
             }
         }
     }
+    /// The closest point on the surface's extension beyond its edge (see
+    /// [`BSplineProjector::project_extended`]).
+    fn project_extended(&self, p: &Vec3, xi0: [f64; 2], cell: Option<[usize; 2]>, margin: [f64; 2]) -> Projection {
+        match (self, cell) {
+            (Self::BSpline(pr), _) => pr.project_extended(p, xi0, margin),
+            (Self::Facet(pr), Some(c)) => pr.project_extended(p, c, margin),
+            (Self::Facet(pr), None) => pr.project(p),
+        }
+    }
     fn evaluate(&self, xi: [f64; 2], cell: Option<[usize; 2]>) -> SurfacePoint {
         match (self, cell) {
             (Self::BSpline(p), _) => p.evaluate(xi),
@@ -213,6 +222,7 @@ impl PairSolver {
         }
         self.projector.update(&self.x_net).map_err(|source| PairError::Master { pair: self.name.clone(), source })?;
         let projector = &self.projector;
+        let edge_tolerance = self.edge_tolerance;
         self.x_slave.iter_mut().zip(&self.slaves).for_each(|(xs, &node)| *xs = x(node));
         self.projections
             .par_iter_mut()
@@ -227,6 +237,21 @@ impl PairSolver {
                 if proj.converged {
                     *sp = projector.evaluate(proj.xi, c);
                 }
+                // Beyond the edge by less than the edge tolerance (a slave edge flush
+                // with the master's): project onto the surface's extension, where the
+                // closest-point conditions hold, and keep the node in contact.
+                if proj.converged && !proj.inside {
+                    let d = xs - proj.x_bar;
+                    let overhang = (d - sp.n_bar * d.dot(&sp.n_bar)).norm();
+                    if overhang <= edge_tolerance {
+                        let margin = [0, 1].map(|al| 2.0 * edge_tolerance / sp.a_alpha[al].norm().max(1e-300));
+                        let ext = projector.project_extended(xs, proj.xi, c, margin);
+                        if ext.converged {
+                            *proj = Projection { inside: true, ..ext };
+                            *sp = projector.evaluate(proj.xi, c);
+                        }
+                    }
+                }
             });
         for s in 0..self.slaves.len() {
             if self.xi_n[s][0].is_nan() && self.usable(s) {
@@ -237,21 +262,13 @@ impl PairSolver {
     }
 
     /// The slave has a foot point on the patch: inside, or beyond an edge by less
-    /// than the edge tolerance (the overhang measured tangentially, 1e-3 of the
-    /// master's mean edge: a slave edge flush with the master edge must not flicker
-    /// in and out of contact by round-off or by a lateral strain difference).
+    /// than the edge tolerance (1e-3 of the master's mean edge, measured tangentially)
+    /// and then on the patch's extension (see [`Self::search`]): a slave edge flush
+    /// with the master edge must not flicker in and out of contact by round-off or by
+    /// a lateral strain difference.
     fn usable(&self, s: usize) -> bool {
         let p = &self.projections[s];
-        let sp = &self.points[s];
-        if !(p.converged && sp.n_bar.iter().all(|v| v.is_finite())) {
-            return false;
-        }
-        if p.inside {
-            return true;
-        }
-        let d = self.x_slave[s] - p.x_bar;
-        let overhang = d - sp.n_bar * d.dot(&sp.n_bar);
-        overhang.norm() <= self.edge_tolerance
+        p.inside && p.converged && self.points[s].n_bar.iter().all(|v| v.is_finite())
     }
 
     /// Appends the node group of every slave that needs a contact element now, and

@@ -208,6 +208,25 @@ impl FacetProjector {
         (finish(p, &res, self.options.outside_tol * self.scale), cell)
     }
 
+    /// Closest point on `cell`'s bilinear map extended beyond the patch edge by up to
+    /// `margin` (parameter units) — see [`crate::spline::BSplineProjector::project_extended`].
+    pub fn project_extended(&self, p: &Vec3, cell: [usize; 2], margin: [f64; 2]) -> Projection {
+        let o = &self.options;
+        let (mut lo, mut hi) = self.facets.cell_bounds(cell);
+        let n = self.facets.n_cells();
+        for al in 0..2 {
+            if cell[al] == 0 {
+                lo[al] -= margin[al];
+            }
+            if cell[al] + 1 == n[al] {
+                hi[al] += margin[al];
+            }
+        }
+        let mid = [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])];
+        let res = newton(|xi| self.facets.jet_in_cell(&self.x, cell, xi), p, mid, (lo, hi), [hi[0] - lo[0], hi[1] - lo[1]], o.tol * self.scale, o.max_iterations);
+        finish(p, &res, o.outside_tol * self.scale)
+    }
+
     /// Evaluation at ξ on a given cell (the one [`Self::project_keeping`] returned).
     pub fn evaluate_in_cell(&self, xi: [f64; 2], cell: [usize; 2]) -> SurfacePoint {
         let mut out = SurfacePoint::default();

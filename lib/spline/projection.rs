@@ -372,6 +372,19 @@ impl BSplineProjector {
         }
     }
 
+    /// Closest point on the patch's polynomial extension beyond its edges: Newton
+    /// from `xi0` with ξ allowed up to `margin` (per direction, in parameter units)
+    /// outside [0, 1]². For slave nodes just beyond the edge, whose clamped foot point
+    /// would not satisfy the closest-point conditions: on the extension it does, so
+    /// the contact residual and its tangent stay consistent.
+    pub fn project_extended(&self, p: &Vec3, xi0: [f64; 2], margin: [f64; 2]) -> Projection {
+        let ns = self.patch.n_spans();
+        let o = &self.options;
+        let max_step = [o.max_step_spans / ns[0] as f64, o.max_step_spans / ns[1] as f64];
+        let res = newton(|xi| self.patch.jet(&self.x, xi), p, xi0, ([-margin[0], -margin[1]], [1.0 + margin[0], 1.0 + margin[1]]), max_step, o.tol * self.scale, o.max_iterations);
+        finish(p, &res, o.outside_tol * self.scale)
+    }
+
     /// Step 2 span by span: Newton bounded to each candidate span of the tree
     /// (branch and bound on the best distance found), the nearest result wins.
     fn project_by_spans(&self, p: &Vec3) -> Projection {
