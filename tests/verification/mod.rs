@@ -3,3 +3,4 @@ mod contact;
 mod parisch;
 mod benchmarks;
 mod friction;
+mod paper_examples;
