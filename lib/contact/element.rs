@@ -184,7 +184,7 @@ pub fn normal_contact(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::fem::fd::{fd_jacobian, rel_err, FdStep};
     use crate::spline::Mat2;
@@ -192,7 +192,7 @@ mod tests {
     /// Cylindrical (radius 4 about the ξ²-parallel axis), wavy control net with unit
     /// control-point spacing: curvature in both directions and a non-orthogonal
     /// parametrisation (the rows are sheared).
-    fn curved_net(na: usize, nb: usize) -> Vec<Vec3> {
+    pub(crate) fn curved_net(na: usize, nb: usize) -> Vec<Vec3> {
         let rad = 4.0;
         let mut x = Vec::with_capacity(na * nb);
         for j in 0..nb {
@@ -208,7 +208,7 @@ mod tests {
 
     /// Closest point near `xi0` by Newton on f_α = (x_s − x̄)·ā_α = 0,
     /// ∂f_α/∂ξ^β = −ā_αβ + (x_s − x̄)·ā_{α,β}; converged to round-off.
-    fn reproject(surf: &MasterSurface, x_all: &[Vec3], xs: &Vec3, xi0: [f64; 2]) -> [f64; 2] {
+    pub(crate) fn reproject(surf: &MasterSurface, x_all: &[Vec3], xs: &Vec3, xi0: [f64; 2]) -> [f64; 2] {
         let mut xi = xi0;
         for _ in 0..50 {
             let (sp, _) = surf.evaluate_local(x_all, xi);

@@ -152,12 +152,7 @@ fn evaluate(
             .unzip();
         let mut dx_bar = sp.a_alpha[0] * dxi[0] + sp.a_alpha[1] * dxi[1];
         let mut da = [sp.a_alpha_beta[0][0] * dxi[0] + sp.a_alpha_beta[0][1] * dxi[1], sp.a_alpha_beta[1][0] * dxi[0] + sp.a_alpha_beta[1][1] * dxi[1]];
-        let mut dab = [[Vec3::zeros(); 2]; 2];
-        for al in 0..2 {
-            for be in 0..2 {
-                dab[al][be] = sp.a_alpha_beta_gamma[al][be][0] * dxi[0] + sp.a_alpha_beta_gamma[al][be][1] * dxi[1];
-            }
-        }
+        let mut dab: [[Vec3; 2]; 2] = std::array::from_fn(|al| std::array::from_fn(|be| sp.a_alpha_beta_gamma[al][be][0] * dxi[0] + sp.a_alpha_beta_gamma[al][be][1] * dxi[1]));
         if let Some((a, c)) = master_dir {
             dx_bar[c] += q[a];
             for al in 0..2 {
@@ -243,40 +238,10 @@ fn evaluate(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::contact::element::tests::{curved_net, reproject};
     use crate::contact::element::MasterSurface;
     use crate::fem::fd::{fd_jacobian, rel_err, FdStep};
-    use crate::spline::{BSplinePatch, FacetSurface, Mat2};
-
-    fn curved_net(na: usize, nb: usize) -> Vec<Vec3> {
-        let rad = 4.0;
-        let mut x = Vec::with_capacity(na * nb);
-        for j in 0..nb {
-            for i in 0..na {
-                let th = (i as f64 + 0.2 * j as f64) / rad;
-                let y = j as f64 + 0.15 * (i as f64 * 0.9).sin();
-                let w = 0.12 * (0.8 * y).sin();
-                x.push(Vec3::new((rad + w) * th.sin(), y, (rad + w) * th.cos() - rad));
-            }
-        }
-        x
-    }
-
-    fn reproject(surf: &MasterSurface, x_all: &[Vec3], xs: &Vec3, xi0: [f64; 2]) -> [f64; 2] {
-        let mut xi = xi0;
-        for _ in 0..50 {
-            let (sp, _) = surf.evaluate_local(x_all, xi);
-            let d = xs - sp.x_bar;
-            let f = nalgebra::Vector2::new(d.dot(&sp.a_alpha[0]), d.dot(&sp.a_alpha[1]));
-            let jac = Mat2::from_fn(|a, b| -sp.a_ab[(a, b)] + d.dot(&sp.a_alpha_beta[a][b]));
-            let step = -jac.try_inverse().unwrap() * f;
-            xi[0] += step[0];
-            xi[1] += step[1];
-            if step.norm() < 1e-17 {
-                break;
-            }
-        }
-        xi
-    }
+    use crate::spline::{BSplinePatch, FacetSurface};
 
     /// K against central differences of r (slave re-projected at every perturbation)
     /// in stick and in slip, facet and B-spline masters of orders 2–4, interior and
@@ -287,7 +252,8 @@ mod tests {
         for order in [0usize, 2, 3, 4] {
             let kk = order.max(2);
             let (ma, mb) = ((na - kk + 1) as f64, (nb - kk + 1) as f64);
-            for xi0 in [[(((na - kk + 1) / 2) as f64 + 0.37) / ma, (((nb - kk + 1) / 2) as f64 + 0.37) / mb], [0.37 / ma, (mb - 1.0 + 0.37) / mb]] {
+            let (ca, cb) = ((na - kk).div_ceil(2) as f64, (nb - kk).div_ceil(2) as f64); // central spans
+            for xi0 in [[(ca + 0.37) / ma, (cb + 0.37) / mb], [0.37 / ma, (mb - 1.0 + 0.37) / mb]] {
                 let (patch, facet);
                 let surf = if order == 0 {
                     facet = FacetSurface::new(na, nb).unwrap();

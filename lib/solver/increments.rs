@@ -75,7 +75,10 @@ fn worst_element(p: &Problem, results: &Results, failure: &IncrementFailure, tri
 
 /// Each pair's summary and per-slave state at the converged increment (states
 /// updated by the Uzawa loop).
-fn contact_results(newton: &Newton) -> (Vec<PairSummary>, Vec<Vec<[f64; 6]>>, Vec<Vec<[f64; 9]>>) {
+/// Per pair: the summary, the state rows and the friction rows.
+type ContactResults = (Vec<PairSummary>, Vec<Vec<[f64; 6]>>, Vec<Vec<[f64; 9]>>);
+
+fn contact_results(newton: &Newton) -> ContactResults {
     let mut summaries = Vec::with_capacity(newton.contact.len());
     let mut states = Vec::with_capacity(newton.contact.len());
     let mut friction = Vec::with_capacity(newton.contact.len());

@@ -159,7 +159,7 @@ impl<'p> Newton<'p> {
     /// of the last increment solved, zero before any; contact search
     /// included), for checks against finite differences: `(residual, col_ptr,
     /// row_idx, values)`, K_ff in compressed sparse columns over the free dofs.
-    pub fn residual_tangent_at(&mut self, u: &[f64], lambda: f64) -> Result<(Vec<f64>, Vec<usize>, Vec<usize>, Vec<f64>), IncrementFailure> {
+    pub fn residual_tangent_at(&mut self, u: &[f64], lambda: f64) -> Result<ResidualTangent, IncrementFailure> {
         self.contact_search(u, 0)?;
         self.assemble(u, lambda).map_err(|f| match f {
             AssemblyFailure::Hex(element, error) => IncrementFailure::Element { iteration: 0, element, error },
@@ -354,6 +354,9 @@ impl<'p> Newton<'p> {
             .collect()
     }
 }
+
+/// `(residual, col_ptr, row_idx, values)` of [`Newton::residual_tangent_at`].
+pub type ResidualTangent = (Vec<f64>, Vec<usize>, Vec<usize>, Vec<f64>);
 
 /// Which local evaluation failed during assembly.
 enum AssemblyFailure {
