@@ -375,6 +375,17 @@ impl PairSolver {
         (0..self.slaves.len()).filter(|&s| self.usable(s) && self.lambda_n[s] + self.settings.eps_n * self.projections[s].g < 0.0).count()
     }
 
+    /// The contact configuration at the last search, one entry per slave: whether it
+    /// is pressed and which control points carry it (its first basis node) — what
+    /// changes when the active set or the master element under a node changes.
+    pub fn configuration(&self, out: &mut Vec<(u32, bool, u32)>) {
+        for s in 0..self.slaves.len() {
+            let pressed = self.usable(s) && self.lambda_n[s] + self.settings.eps_n * self.projections[s].g < 0.0;
+            let first = if self.usable(s) { self.points[s].basis.nodes().first().map_or(u32::MAX, |&k| self.net[k]) } else { u32::MAX };
+            out.push((self.slaves[s], pressed, first));
+        }
+    }
+
     /// Slaves whose closest-point projection failed at the last search (treated as
     /// out of contact), and the first of them.
     pub fn failed_projections(&self) -> (usize, Option<u32>) {

@@ -33,6 +33,8 @@ pub enum IncrementFailure {
     Contact { iteration: u32, pair: String, node_tag: u64, error: ContactElementError },
     #[error("iteration {iteration}: {message}")]
     ContactSetup { iteration: u32, message: String },
+    #[error("iteration {iteration}: the contact configuration cycles between two states (relative residual {residual:.3e}): slave nodes {nodes} alternate between in and out of contact or between master elements")]
+    ContactCycling { iteration: u32, residual: f64, nodes: String },
 }
 
 /// A local (element-level) failure during assembly.
@@ -248,6 +250,9 @@ impl<'p> Newton<'p> {
         let mut energy = f64::INFINITY;
         let mut first_residual = 0.0;
         let mut max_reaction: f64 = 0.0;
+        // contact configurations of the last three iterates, to detect a 2-cycle
+        let mut configs: [Vec<(u32, bool, u32)>; 3] = Default::default();
+        let mut cycling = 0u32;
         for iteration in 0..=self.settings.max_iterations {
             let t = Instant::now();
             self.contact_search(u, iteration)?;
@@ -318,6 +323,29 @@ impl<'p> Newton<'p> {
             if iteration >= 4 && residual > 1e6 * first_residual.max(self.settings.residual_tolerance) {
                 on_iteration(&row);
                 return Err(IncrementFailure::Diverged { iteration, residual });
+            }
+            // Period-2 cycle of the contact configuration (C = A, B, A, B, …) for three
+            // iterations in a row: Newton will not settle; cut the increment back now.
+            if !self.contact.is_empty() {
+                configs.rotate_right(1);
+                configs[0].clear();
+                for pair in &self.contact {
+                    pair.configuration(&mut configs[0]);
+                }
+                let two_cycle = iteration >= 2 && configs[0] == configs[2] && configs[0] != configs[1];
+                cycling = if two_cycle { cycling + 1 } else { 0 };
+                if cycling >= 3 {
+                    let tags = &p.node_tags;
+                    let flipping: Vec<String> = configs[0]
+                        .iter()
+                        .zip(&configs[1])
+                        .filter(|(a, b)| a != b)
+                        .take(8)
+                        .map(|(a, _)| tags.get(a.0 as usize).copied().unwrap_or(a.0 as u64).to_string())
+                        .collect();
+                    on_iteration(&row);
+                    return Err(IncrementFailure::ContactCycling { iteration, residual, nodes: flipping.join(", ") });
+                }
             }
             let t = Instant::now();
             self.linear.factor(self.assembly.values()).map_err(|error| IncrementFailure::Linear { iteration, error })?;
