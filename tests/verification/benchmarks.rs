@@ -102,3 +102,27 @@ fn curved_master_bspline_against_facets() {
     // same mesh, the smooth master's pressure is smoother than the facets'
     assert!(f(&runs2[1], &["centreline", "d2_interior_max"]) < 0.5 * f(&runs2[0], &["centreline", "d2_interior_max"]));
 }
+
+/// The facet master on the shipped curved mesh: a pad node sits over a concave crease
+/// of the indented base, where node-to-facet contact has no equilibrium (see
+/// curved-facet.yaml). Newton must say so — a period-2 cycle of the contact
+/// configuration, naming the node — instead of iterating to the limit, and the solve
+/// stops with exit code 3 after its cutbacks.
+#[test]
+fn facet_on_a_concave_crease_reports_the_cycling_node() {
+    let dir = tempdir();
+    std::fs::copy(repo().join("meshes/curved.msh"), dir.path().join("c.msh")).unwrap();
+    assert!(run("sc-import", &["c.msh", "-o", "c.scmesh"], dir.path()).status.success());
+    assert!(run("sc-tag", &["c.scmesh", "--pair", "contact:pad_bottom:base_top:facet", "-o", "c.sccontact"], dir.path()).status.success());
+    let setup = "materials:\n  - {body: base, model: neo_hookean, E: 1000.0, nu: 0.3}\n  - {body: pad, model: neo_hookean, E: 1000.0, nu: 0.3}\n\
+constraints:\n  - {set: base_bottom, fix: [x, y, z]}\n  - {set: pad_top, fix: [x, y], displacement: {z: -0.4}}\n\
+contact:\n  - {pair: contact, eps_n: 1.0e5, enforcement: augmented_lagrangian, penetration_tolerance: 1.0e-5}\n\
+increments: {count: 5, max_cutbacks: 1}\n";
+    std::fs::write(dir.path().join("s.yaml"), setup).unwrap();
+    let o = run("sc-solve", &["c.sccontact", "--setup", "s.yaml", "-o", "r.scres"], dir.path());
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(3), "{err}");
+    assert!(err.contains("the contact configuration cycles between two states") && err.contains("slave nodes 168"), "{err}");
+    // within a few iterations, not at max_iterations
+    assert!(!err.contains("did not converge in 25 iterations"), "{err}");
+}
