@@ -225,8 +225,10 @@ pub struct ContactSetup {
     /// Pair name, as given to `sc-tag`.
     pub pair: String,
     /// Normal penalty ε_N: traction per unit penetration (force/length³); for a slave
-    /// given as a node set (no tributary area) force per unit penetration.
-    pub eps_n: f64,
+    /// given as a node set (no tributary area) force per unit penetration. Default:
+    /// 25 G/h (`solver::problem::default_penalty`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub eps_n: Option<f64>,
     #[serde(default)]
     pub enforcement: Enforcement,
     /// Largest accepted penetration −g_N (a length), augmented Lagrangian only.
@@ -242,7 +244,7 @@ pub struct ContactSetup {
     /// Coulomb friction coefficient μ (0: frictionless).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub mu: f64,
-    /// Tangential penalty ε_T (traction per unit elastic slip); required when μ > 0.
+    /// Tangential penalty ε_T (traction per unit elastic slip); default ε_N.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub eps_t: Option<f64>,
 }

@@ -64,6 +64,8 @@ pub struct ContactDefinition {
     pub areas: Vec<f64>,
     /// Mean edge length of the master net (reference configuration).
     pub h_master: f64,
+    /// ε_N was not given: [`default_penalty`].
+    pub eps_n_default: bool,
 }
 
 /// The problem.
@@ -127,7 +129,7 @@ fn material(file: &str, m: &setup::MaterialSetup) -> Result<MaterialModel, Probl
 }
 
 /// Match the setup's `contact` entries with the model's pairs and resolve them.
-fn contact_definitions(mesh: &Mesh, pairs: &[ContactPair], setup: &SolveSetup, file: &str) -> Result<Vec<ContactDefinition>, ProblemError> {
+fn contact_definitions(mesh: &Mesh, pairs: &[ContactPair], setup: &SolveSetup, file: &str, materials: &[MaterialModel], hex_material: &[u32]) -> Result<Vec<ContactDefinition>, ProblemError> {
     let invalid = |message: String| ProblemError::Invalid { file: file.into(), message };
     let pair_names = || names(pairs.iter().map(|p| p.name.as_str()).collect());
     for (i, c) in setup.contact.iter().enumerate() {
@@ -145,12 +147,15 @@ fn contact_definitions(mesh: &Mesh, pairs: &[ContactPair], setup: &SolveSetup, f
     let mut out = Vec::with_capacity(pairs.len());
     for pair in pairs {
         let Some(c) = setup.contact.iter().find(|c| c.pair == pair.name) else {
-            return Err(invalid(format!("contact pair '{}' has no entry under `contact` (it needs at least `eps_n`)", pair.name)));
+            return Err(invalid(format!("contact pair '{}' has no entry under `contact` (give at least `- {{pair: {}}}`)", pair.name, pair.name)));
         };
         let bad = |m: String| invalid(format!("contact pair '{}': {m}", pair.name));
-        if !(c.eps_n.is_finite() && c.eps_n > 0.0) {
-            return Err(bad(format!("eps_n must be a positive number, found {}", c.eps_n)));
-        }
+        let h = mean_net_edge(mesh, pair);
+        let (eps_n, eps_n_default) = match c.eps_n {
+            Some(e) if !(e.is_finite() && e > 0.0) => return Err(bad(format!("eps_n must be a positive number, found {e}"))),
+            Some(e) => (e, false),
+            None => (default_penalty(mesh, pair, materials, hex_material, h), true),
+        };
         for (key, v) in [("penetration_tolerance", c.penetration_tolerance), ("penetration_tolerance_relative", c.penetration_tolerance_relative)] {
             if let Some(v) = v {
                 if !(v.is_finite() && v > 0.0) {
@@ -160,12 +165,11 @@ fn contact_definitions(mesh: &Mesh, pairs: &[ContactPair], setup: &SolveSetup, f
         }
         let eps_t = match (c.mu, c.eps_t) {
             (mu, _) if !(mu.is_finite() && mu >= 0.0) => return Err(bad(format!("mu must be zero or positive, found {mu}"))),
-            (mu, None) if mu > 0.0 => return Err(bad("friction (mu > 0) needs the tangential penalty `eps_t`".into())),
             (_, Some(e)) if !(e.is_finite() && e > 0.0) => return Err(bad(format!("eps_t must be a positive number, found {e}"))),
+            (mu, None) if mu > 0.0 => eps_n, // default: the normal penalty
             (_, e) => e.unwrap_or(0.0),
         };
         let areas = tributary_areas(mesh, &pair.slave_nodes, (pair.slave_kind == SlaveKind::FaceSet).then_some(pair.slave.as_str()));
-        let h = mean_net_edge(mesh, pair);
         let penetration_tolerance = match (c.penetration_tolerance, c.penetration_tolerance_relative) {
             (Some(_), Some(_)) => return Err(bad("give `penetration_tolerance` or `penetration_tolerance_relative`, not both".into())),
             (Some(t), None) => t,
@@ -174,12 +178,42 @@ fn contact_definitions(mesh: &Mesh, pairs: &[ContactPair], setup: &SolveSetup, f
         };
         out.push(ContactDefinition {
             pair: pair.clone(),
-            settings: PairSettings { eps_n: c.eps_n, enforcement: c.enforcement, penetration_tolerance, max_augmentations: c.max_augmentations, mu: c.mu, eps_t },
+            settings: PairSettings { eps_n, enforcement: c.enforcement, penetration_tolerance, max_augmentations: c.max_augmentations, mu: c.mu, eps_t },
+            eps_n_default,
             areas,
             h_master: h,
         });
     }
     Ok(out)
+}
+
+/// The default normal penalty when a pair gives no `eps_n`:
+/// ```text
+/// ε_N = 25 G / h
+/// ```
+/// G the smaller shear modulus of the bodies on either side (the hexahedra of the
+/// master face set and those holding slave nodes), h the master net's mean edge
+/// length. 25 G/h ≈ 10 E/h at ν = 0.3: the contact spring of a node, ε_N A_s ≈ 10 E h,
+/// is ten times the stiffness of an element of the softer body, so the penalty
+/// penetration is ~10 % of that element's elastic deformation, and each Uzawa update
+/// of the augmented Lagrangian shrinks it about tenfold (contraction
+/// k_body / (k_body + ε_N A_s) ≈ 1/11) — stiff enough to be accurate after a few
+/// updates, soft enough not to spoil the conditioning.
+pub fn default_penalty(mesh: &Mesh, pair: &ContactPair, materials: &[MaterialModel], hex_material: &[u32], h: f64) -> f64 {
+    use crate::material::Material;
+    let mut g = f64::INFINITY;
+    if let Some(fs) = mesh.face_set(&pair.master) {
+        for f in &fs.faces {
+            g = g.min(materials[hex_material[f.element as usize] as usize].shear_modulus());
+        }
+    }
+    let slave: std::collections::HashSet<u32> = pair.slave_nodes.iter().copied().collect();
+    for (e, hex) in mesh.hexes.iter().enumerate() {
+        if hex.iter().any(|n| slave.contains(n)) {
+            g = g.min(materials[hex_material[e] as usize].shear_modulus());
+        }
+    }
+    25.0 * g / h
 }
 
 /// Mean edge length of a pair's master net (reference configuration).
@@ -333,7 +367,7 @@ impl Problem {
                 }
             }
         }
-        let contact = contact_definitions(mesh, pairs, setup, file)?;
+        let contact = contact_definitions(mesh, pairs, setup, file, &materials, &hex_material)?;
         Ok(Self {
             X: mesh.nodes.iter().map(|p| Vector3::new(p[0], p[1], p[2])).collect(),
             hexes: mesh.hexes.clone(),

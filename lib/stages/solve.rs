@@ -48,14 +48,15 @@ pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, 
     let factors = setup.load_factors(setup_name)?;
     let mut newton = Newton::new(&problem, setup.newton.clone(), setup.linear_solver)?;
     let mut log = SolveLog::new(verbosity, factors.len());
-    for c in &newton.contact {
+    for (c, def) in newton.contact.iter().zip(&problem.contact) {
         let s = &c.settings;
         log.line(&format!(
-            "contact pair '{}': {} slave nodes, {} master, ε_N = {:e}, {}{}{}",
+            "contact pair '{}': {} slave nodes, {} master, ε_N = {:e}{}, {}{}{}",
             c.name,
             c.slaves.len(),
             c.master_kind.name(),
             s.eps_n,
+            if def.eps_n_default { format!(" (default 25 G/h, h = {:.4e})", def.h_master) } else { String::new() },
             match s.enforcement {
                 crate::format::setup::Enforcement::Penalty => "penalty",
                 crate::format::setup::Enforcement::AugmentedLagrangian => "augmented Lagrangian",

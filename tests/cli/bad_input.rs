@@ -124,12 +124,12 @@ fn contact_setup_mistakes() {
     assert!(o.status.success(), "{}", stderr(&o));
     let base = "materials:\n  - {body: upper, model: neo_hookean, E: 1.0e9, nu: 0.3}\n  - {body: lower, model: neo_hookean, E: 1.0e10, nu: 0.3}\nconstraints:\n  - {set: lower_base, fix: [x, y, z]}\n";
     let cases: [(&str, &str, &[&str]); 10] = [
-        ("contact:\n  - {pair: contact, eps_n: 1.0e5, mu: 0.2}\n", "p.sccontact", &["bad.yaml", "friction (mu > 0) needs the tangential penalty `eps_t`"]),
+        ("contact:\n  - {pair: contact, eps_n: 0.0}\n", "p.sccontact", &["bad.yaml", "eps_n must be a positive number, found 0"]),
         ("contact:\n  - {pair: contact, eps_n: 1.0e5, mu: -0.2, eps_t: 1.0}\n", "p.sccontact", &["bad.yaml", "mu must be zero or positive"]),
         ("contact:\n  - {pair: contact, eps_n: 1.0e5, mu: 0.2, eps_t: 0.0}\n", "p.sccontact", &["bad.yaml", "eps_t must be a positive number"]),
         ("contact:\n  - {pair: contact, eps_n: 1.0e5, mu: 0.2, eps_t: 1.0}\nlinear_solver: cholesky\n", "p.sccontact", &["cholesky needs a symmetric tangent", "friction", "use auto or lu"]),
         ("contact:\n  - {pair: contact, eps_n: 1.0e5}\nloads:\n  - {set: load_node, force: [0, 0, -1], curve: ramp2}\n", "p.sccontact", &["bad.yaml", "load 1 uses curve 'ramp2', which `curves` does not define (it has: none)"]),
-        ("", "p.sccontact", &["bad.yaml", "contact pair 'contact' has no entry under `contact`"]),
+        ("", "p.sccontact", &["bad.yaml", "contact pair 'contact' has no entry under `contact` (give at least `- {pair: contact}`)"]),
         ("contact:\n  - {pair: contakt, eps_n: 1.0e5}\n", "p.sccontact", &["bad.yaml", "contact pair 'contakt' does not exist", "contact"]),
         ("contact:\n  - {pair: contact, eps_n: -1.0}\n", "p.sccontact", &["bad.yaml", "eps_n must be a positive number"]),
         ("contact:\n  - {pair: contact, eps_n: 1.0e5, penetration_tolerance: 1.0e-3, penetration_tolerance_relative: 1.0e-3}\n", "p.sccontact", &["bad.yaml", "not both"]),

@@ -104,7 +104,7 @@ fn parisch_facet_and_augmented_lagrangian_match_calculix() {
                 // Uzawa contracts the penetration by about k_body / (k_body + ε_N A_s) per
                 // update: with the paper's ε_N = 1e5 against E = 1e9 that is 0.9997
                 // (20 updates leave 1.7e-5 of 5e-2). ε_N = 1e10 makes it converge in a few.
-                setup.contact[0].eps_n = 1e10;
+                setup.contact[0].eps_n = Some(1e10);
             }
             setup.contact[0].penetration_tolerance = Some(1e-8);
             let yaml = serde_yaml::to_string(&setup).unwrap();
