@@ -112,7 +112,30 @@ pub fn write_results_pvd(results: &Results, output: &Path) -> Result<String, Sta
         entries.push((inc.info.load_factor, name));
     }
     vtk::write_pvd(output, &entries)?;
-    Ok(format!("wrote {} ({} increments + the undeformed state)", output.display(), results.increments.len()))
+    // the master surfaces moving with their bodies: one series per pair
+    let mut surfaces = Vec::new();
+    for p in &results.pairs {
+        let mut series = Vec::new();
+        for (k, inc) in std::iter::once(&zero).chain(results.increments.iter()).enumerate() {
+            let x: Vec<Vec3> = p
+                .net
+                .nodes
+                .iter()
+                .map(|&n| {
+                    let (x0, u) = (mesh.nodes[n as usize], inc.u[n as usize]);
+                    Vec3::new(x0[0] + u[0], x0[1] + u[1], x0[2] + u[2])
+                })
+                .collect();
+            let name = format!("{stem}_{}_surface_{k}.vtu", p.name);
+            master_surface_grid(p, &x)?.write_vtu(&dir.join(&name))?;
+            series.push((inc.info.load_factor, name));
+        }
+        let pvd = dir.join(format!("{stem}_{}_surface.pvd", p.name));
+        vtk::write_pvd(&pvd, &series)?;
+        surfaces.push(pvd.display().to_string());
+    }
+    let also = if surfaces.is_empty() { String::new() } else { format!("; master surfaces (deformed, per increment): {}", surfaces.join(", ")) };
+    Ok(format!("wrote {} ({} increments + the undeformed state){also}", output.display(), results.increments.len()))
 }
 
 /// Contact point data on the slave nodes of every pair (state columns of

@@ -72,6 +72,11 @@ fn parisch_pipeline_matches_calculix() {
         assert!(f.iter().all(|v| v.abs() < 1e-6 * F), "{set}: {f:?}");
     }
     assert_eq!(inc.info.contact[0].active, 9);
+    // the master surface follows the lower block: one series, the undeformed and the
+    // converged increment
+    let surf = std::fs::read_to_string(dir.path().join("pipelines/out/parisch_contact_surface.pvd")).unwrap();
+    assert_eq!(surf.matches("<DataSet").count(), 2, "{surf}");
+    assert!(dir.path().join("pipelines/out/parisch_contact_surface_1.vtu").is_file());
     // what ParaView shows: the contact fields on the slave nodes (read by meshio)
     let o = python_script("check_pvd.py", &[&dir.path().join("pipelines/out/parisch.pvd")]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
