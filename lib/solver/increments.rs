@@ -49,7 +49,50 @@ pub struct SolveSummary {
 /// Where the results go.
 pub struct Outputs<'a> {
     pub results: &'a Path,
+    /// Convergence history (one row per Newton iteration).
     pub csv: Option<&'a Path>,
+    /// Force history (one row per converged increment): reactions and contact forces.
+    pub forces_csv: Option<&'a Path>,
+}
+
+/// The force history of the converged increments as CSV: load factor, the reaction
+/// of every constrained set (x, y, z), and per contact pair the force the master
+/// exerts on the slave body, its tangential part, the active / sticking / sliding
+/// nodes and the Uzawa updates — the curves a user plots (e.g. an indenter's
+/// vertical and horizontal force against its travel).
+pub fn forces_csv(results: &Results) -> String {
+    let mut out = String::from("increment,load_factor");
+    let first = results.increments.first();
+    let sets: Vec<String> = first.map(|i| i.info.reactions.iter().map(|r| r.set.clone()).collect()).unwrap_or_default();
+    for s in &sets {
+        out.push_str(&format!(",reaction:{s}:x,reaction:{s}:y,reaction:{s}:z"));
+    }
+    for p in &results.pairs {
+        let n = &p.name;
+        out.push_str(&format!(",contact:{n}:x,contact:{n}:y,contact:{n}:z,tangential:{n}:x,tangential:{n}:y,tangential:{n}:z,active:{n},stick:{n},slip:{n},augmentations:{n}"));
+    }
+    out.push('\n');
+    for (k, inc) in results.increments.iter().enumerate() {
+        out.push_str(&format!("{},{:e}", k + 1, inc.info.load_factor));
+        for s in &sets {
+            let f = inc.info.reactions.iter().find(|r| &r.set == s).map_or([f64::NAN; 3], |r| r.force);
+            out.push_str(&format!(",{:e},{:e},{:e}", f[0], f[1], f[2]));
+        }
+        for (i, _) in results.pairs.iter().enumerate() {
+            match inc.info.contact.get(i) {
+                Some(c) => {
+                    let (t, st, sl) = c.friction.as_ref().map_or(([0.0; 3], 0, 0), |f| (f.tangential_force, f.stick, f.slip));
+                    out.push_str(&format!(
+                        ",{:e},{:e},{:e},{:e},{:e},{:e},{},{},{},{}",
+                        c.force[0], c.force[1], c.force[2], t[0], t[1], t[2], c.active, st, sl, c.augmentations
+                    ));
+                }
+                None => out.push_str(",,,,,,,,,,"),
+            }
+        }
+        out.push('\n');
+    }
+    out
 }
 
 /// The element to look at: the failing one, or else the one with the smallest
@@ -139,6 +182,9 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
         results.write(out.results)?;
         if let Some(csv) = out.csv {
             write_atomic(csv, log.csv().as_bytes())?;
+        }
+        if let Some(f) = out.forces_csv {
+            write_atomic(f, forces_csv(results).as_bytes())?;
         }
         Ok(())
     };

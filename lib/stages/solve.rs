@@ -23,7 +23,8 @@ pub struct SolveReport {
     pub seconds: f64,
 }
 
-/// The CSV beside a results file: `results.scres` → `results.convergence.csv`.
+/// The CSV beside a results file: `results.scres` → `results.convergence.csv`. (The
+/// force history goes to `results.forces.csv`, always beside the results.)
 pub fn default_csv_path(output: &Path) -> Option<std::path::PathBuf> {
     (output.as_os_str() != "-").then(|| output.with_extension("convergence.csv"))
 }
@@ -86,7 +87,8 @@ pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, 
         mesh,
         pairs,
     };
-    let outputs = Outputs { results: output, csv };
+    let forces = output.with_extension("forces.csv");
+    let outputs = Outputs { results: output, csv, forces_csv: Some(&forces) };
     let summary = increments::solve(&mut newton, &factors, setup.increments.max_cutbacks, &mut results, &outputs, &mut log);
     if !newton.contact.is_empty() {
         log.line(&format!("contact: the sparsity pattern was rebuilt {} times as contact elements changed", newton.pattern_rebuilds));

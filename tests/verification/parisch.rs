@@ -72,6 +72,14 @@ fn parisch_pipeline_matches_calculix() {
         assert!(f.iter().all(|v| v.abs() < 1e-6 * F), "{set}: {f:?}");
     }
     assert_eq!(inc.info.contact[0].active, 9);
+    // the force history a user plots: reactions and contact force per increment
+    let forces = std::fs::read_to_string(dir.path().join("pipelines/out/parisch.forces.csv")).unwrap();
+    let mut lines = forces.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let row: Vec<f64> = lines.next().unwrap().split(',').map(|v| v.parse().unwrap()).collect();
+    let col = |name: &str| row[header.iter().position(|h| *h == name).unwrap_or_else(|| panic!("{name} not in {header:?}"))];
+    assert!((col("reaction:lower_base:z") - F).abs() < 1e-8 * F && (col("contact:contact:z") - F).abs() < 1e-8 * F, "{forces}");
+    assert_eq!(col("active:contact"), 9.0);
     // the master surface follows the lower block: one series, the undeformed and the
     // converged increment
     let surf = std::fs::read_to_string(dir.path().join("pipelines/out/parisch_contact_surface.pvd")).unwrap();
