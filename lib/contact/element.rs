@@ -225,6 +225,40 @@ pub(crate) mod tests {
         xi
     }
 
+    /// Central differences of an element residual over u = [x_s; x_A] (the control
+    /// points of `nodes`), the slave re-projected near `xi0` at every perturbation;
+    /// `residual(x_s, sp, r)` evaluates the element at the perturbed state. h = 1e-7 ×
+    /// max(|u_j|, 1): truncation ~h² × (third derivative) ≈ 1e-14 |K|, round-off
+    /// ~ε|r|/h ≈ 1e-9 |r|, projection round-off ~1e-16 in ξ̄ → 1e-9, all ≪ 1e-6 of K.
+    pub(crate) fn fd_element(surf: &MasterSurface, x_all: &[Vec3], nodes: &[usize], xs0: &Vec3, xi0: [f64; 2], residual: impl Fn(&Vec3, &SurfacePoint, &mut DVector<f64>)) -> DMatrix<f64> {
+        let m = 3 * (1 + nodes.len());
+        let mut u = vec![0.0; m];
+        for c in 0..3 {
+            u[c] = xs0[c];
+            for (a, &nd) in nodes.iter().enumerate() {
+                u[3 * (1 + a) + c] = x_all[nd][c];
+            }
+        }
+        fd_jacobian(
+            |v, out| {
+                let mut x = x_all.to_vec();
+                for (a, &nd) in nodes.iter().enumerate() {
+                    x[nd] = Vec3::new(v[3 * (1 + a)], v[3 * (1 + a) + 1], v[3 * (1 + a) + 2]);
+                }
+                let xs = Vec3::new(v[0], v[1], v[2]);
+                let xi = reproject(surf, &x, &xs, xi0);
+                let (sp, _) = surf.evaluate_local(&x, xi);
+                assert_eq!(sp.basis.nodes(), nodes, "perturbation left the span");
+                let mut rr = DVector::zeros(m);
+                residual(&xs, &sp, &mut rr);
+                out.copy_from_slice(rr.as_slice());
+            },
+            &u,
+            m,
+            FdStep { rel_step: 1e-7, scale: 1.0 },
+        )
+    }
+
     struct Case {
         name: String,
         surf_kind: (usize, usize, usize), // (na, nb, order); order 0 = facet
@@ -248,7 +282,6 @@ pub(crate) mod tests {
         let (sp0, xm0) = surf.evaluate_local(&x_all, case.xi0);
         let nodes: Vec<usize> = sp0.basis.nodes().to_vec();
         let nc = nodes.len();
-        let m = 3 * (1 + nc);
         let g0 = -1e-2 * size;
         let xs0 = sp0.x_bar + sp0.n_bar * g0;
         let area = 0.7;
@@ -273,35 +306,10 @@ pub(crate) mod tests {
             assert!(f.norm() < 1e-12 * scale, "{}: force sum {f:?}", case.name);
             assert!(mom.norm() < 1e-10 * scale * 10.0, "{}: moment {mom:?}", case.name);
             assert!((&k - k.transpose()).norm() < 1e-10 * k.norm(), "{}: K not symmetric", case.name);
-            // u = [x_s; x_A]
-            let mut u = vec![0.0; m];
-            for c in 0..3 {
-                u[c] = xs0[c];
-                for a in 0..nc {
-                    u[3 * (1 + a) + c] = xm0[a][c];
-                }
-            }
-            // Central differences with h = 1e-7 × max(|u_j|, size): truncation
-            // ~h²|r'''| ≈ 1e-14 |K|, round-off ~ε_mach|r|/h ≈ 1e-9 |r|, projection
-            // round-off ~1e-16 in ξ̄ → 1e-9 — all ≪ 1e-6 relative to K (≥ |t_N|A_s κ).
-            let fd = fd_jacobian(
-                |v, out| {
-                    let mut x = x_all.clone();
-                    for (a, &nd) in nodes.iter().enumerate() {
-                        x[nd] = Vec3::new(v[3 * (1 + a)], v[3 * (1 + a) + 1], v[3 * (1 + a) + 2]);
-                    }
-                    let xs = Vec3::new(v[0], v[1], v[2]);
-                    let xi = reproject(&surf, &x, &xs, case.xi0);
-                    let (sp, _xm) = surf.evaluate_local(&x, xi);
-                    assert_eq!(sp.basis.nodes(), &nodes[..], "perturbation left the span");
-                    let (mut rr, mut kk) = (DVector::zeros(0), DMatrix::zeros(0, 0));
-                    normal_contact(&xs, &sp, &NormalLaw { lambda_n: lambda, eps_n: eps, area, touch: 0.0 }, &mut rr, &mut kk).unwrap();
-                    out.copy_from_slice(rr.as_slice());
-                },
-                &u,
-                m,
-                FdStep { rel_step: 1e-7, scale: size },
-            );
+            let fd = fd_element(&surf, &x_all, &nodes, &xs0, case.xi0, |xs, sp, rr| {
+                let mut kk = DMatrix::zeros(0, 0);
+                normal_contact(xs, sp, &NormalLaw { lambda_n: lambda, eps_n: eps, area, touch: 0.0 }, rr, &mut kk).unwrap();
+            });
             let e = rel_err(k.as_slice(), fd.as_slice());
             eprintln!("FD {} λ={lambda} ε={eps}: rel err {e:.2e} (|K|={:.3e})", case.name, k.norm());
             assert!(e < 1e-6, "{} λ={lambda} ε={eps}: FD rel err {e:e}", case.name);

@@ -238,9 +238,9 @@ fn evaluate(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::contact::element::tests::{curved_net, reproject};
+    use crate::contact::element::tests::{curved_net, fd_element};
     use crate::contact::element::MasterSurface;
-    use crate::fem::fd::{fd_jacobian, rel_err, FdStep};
+    use crate::fem::fd::rel_err;
     use crate::spline::{BSplinePatch, FacetSurface};
 
     /// K against central differences of r (slave re-projected at every perturbation)
@@ -263,10 +263,8 @@ mod tests {
                     MasterSurface::BSpline(&patch)
                 };
                 let x_all = curved_net(na, nb);
-                let (sp0, xm0) = surf.evaluate_local(&x_all, xi0);
+                let (sp0, _) = surf.evaluate_local(&x_all, xi0);
                 let nodes = sp0.basis.nodes().to_vec();
-                let nc = nodes.len();
-                let m = 3 * (1 + nc);
                 let xs0 = sp0.x_bar - sp0.n_bar * 1e-2;
                 let normal = NormalLaw { lambda_n: -1.0, eps_n: 100.0, area: 0.7, touch: 0.0 };
                 // slip of 0.02 in ξ: ε_T a Δξ ≈ 1e3·1·0.02·ns ≈ 20·ns ≫ μ|t_N| = 0.3·2 (slip);
@@ -289,31 +287,10 @@ mod tests {
                         assert!((&r - &r2).norm() < 1e-12 * r2.norm() && (&k - &k2).norm() < 1e-10 * k2.norm(), "order {order}: dual K vs analytical K");
                         continue;
                     }
-                    let mut u = vec![0.0; m];
-                    for c in 0..3 {
-                        u[c] = xs0[c];
-                        for a in 0..nc {
-                            u[3 * (1 + a) + c] = xm0[a][c];
-                        }
-                    }
-                    let fd = fd_jacobian(
-                        |v, out| {
-                            let mut x = x_all.clone();
-                            for (a, &nd) in nodes.iter().enumerate() {
-                                x[nd] = Vec3::new(v[3 * (1 + a)], v[3 * (1 + a) + 1], v[3 * (1 + a) + 2]);
-                            }
-                            let xs = Vec3::new(v[0], v[1], v[2]);
-                            let xi = reproject(&surf, &x, &xs, xi0);
-                            let (sp, _) = surf.evaluate_local(&x, xi);
-                            assert_eq!(sp.basis.nodes(), &nodes[..], "perturbation left the span");
-                            let (mut rr, mut kk) = (DVector::zeros(0), DMatrix::zeros(0, 0));
-                            frictional_contact(&xs, &sp, &normal, &fr, &mut rr, &mut kk).unwrap();
-                            out.copy_from_slice(rr.as_slice());
-                        },
-                        &u,
-                        m,
-                        FdStep { rel_step: 1e-7, scale: 1.0 },
-                    );
+                    let fd = fd_element(&surf, &x_all, &nodes, &xs0, xi0, |xs, sp, rr| {
+                        let mut kk = DMatrix::zeros(0, 0);
+                        frictional_contact(xs, sp, &normal, &fr, rr, &mut kk).unwrap();
+                    });
                     let e = rel_err(k.as_slice(), fd.as_slice());
                     let asym = (&k - k.transpose()).norm() / k.norm();
                     eprintln!("friction FD order {order} ξ0 {xi0:.3?} {}: rel err {e:.2e}, asymmetry {asym:.2e}", if want_slip { "slip" } else { "stick" });
