@@ -116,6 +116,7 @@ fn patch_test_matching_meshes_is_exact() {
 /// deviation from the exact pressure, pinned at the measured value + 20 % so a change
 /// that degrades it is caught (values in docs/validation.md).
 #[test]
+#[allow(clippy::type_complexity)] // the table of cases
 fn patch_test_one_pass_deviation_is_pinned() {
     // (lower, upper, master, orders, measured pointwise deviation, measured total deviation)
     let cases: [(usize, usize, MasterKind, Option<[usize; 2]>, f64, f64); 4] = [
