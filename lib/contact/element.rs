@@ -192,6 +192,30 @@ pub(crate) mod tests {
     /// Cylindrical (radius 4 about the ξ²-parallel axis), wavy control net with unit
     /// control-point spacing: curvature in both directions and a non-orthogonal
     /// parametrisation (the rows are sheared).
+    /// A test master that owns its surface: facets (order 0) or a B-spline patch of
+    /// equal orders in both directions over an na × nb net.
+    pub(crate) enum TestMaster {
+        BSpline(BSplinePatch),
+        Facet(FacetSurface),
+    }
+
+    impl TestMaster {
+        pub(crate) fn new(na: usize, nb: usize, order: usize) -> Self {
+            if order == 0 {
+                Self::Facet(FacetSurface::new(na, nb).unwrap())
+            } else {
+                Self::BSpline(BSplinePatch::new(na, nb, order, order).unwrap())
+            }
+        }
+
+        pub(crate) fn surface(&self) -> MasterSurface<'_> {
+            match self {
+                Self::BSpline(p) => MasterSurface::BSpline(p),
+                Self::Facet(f) => MasterSurface::Facet(f),
+            }
+        }
+    }
+
     pub(crate) fn curved_net(na: usize, nb: usize) -> Vec<Vec3> {
         let rad = 4.0;
         let mut x = Vec::with_capacity(na * nb);
@@ -268,15 +292,8 @@ pub(crate) mod tests {
     /// Runs one geometry with the laws (λ_N, ε_N) below and returns the worst FD error.
     fn check_case(case: &Case) -> f64 {
         let (na, nb, order) = case.surf_kind;
-        let patch;
-        let facet;
-        let surf = if order == 0 {
-            facet = FacetSurface::new(na, nb).unwrap();
-            MasterSurface::Facet(&facet)
-        } else {
-            patch = BSplinePatch::new(na, nb, order, order).unwrap();
-            MasterSurface::BSpline(&patch)
-        };
+        let master = TestMaster::new(na, nb, order);
+        let surf = master.surface();
         let x_all = curved_net(na, nb);
         let size = 1.0; // control point spacing = element size
         let (sp0, xm0) = surf.evaluate_local(&x_all, case.xi0);

@@ -238,14 +238,15 @@ fn evaluate(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::contact::element::tests::{curved_net, fd_element};
+    use crate::contact::element::tests::{curved_net, fd_element, TestMaster};
     use crate::contact::element::MasterSurface;
     use crate::fem::fd::rel_err;
-    use crate::spline::{BSplinePatch, FacetSurface};
+    use crate::spline::BSplinePatch;
 
     /// K against central differences of r (slave re-projected at every perturbation)
     /// in stick and in slip, facet and B-spline masters of orders 2–4, interior and
-    /// edge-adjacent spans; and with μ = ε_T = 0 the frictionless element's K.
+    /// edge-adjacent spans; and with μ > 0, ε_T = 0 and no history (the dual-number path
+    /// with zero tangential traction) the analytical frictionless K.
     #[test]
     fn tangent_matches_finite_differences_in_stick_and_slip() {
         let (na, nb) = (7, 6);
@@ -254,14 +255,8 @@ mod tests {
             let (ma, mb) = ((na - kk + 1) as f64, (nb - kk + 1) as f64);
             let (ca, cb) = ((na - kk).div_ceil(2) as f64, (nb - kk).div_ceil(2) as f64); // central spans
             for xi0 in [[(ca + 0.37) / ma, (cb + 0.37) / mb], [0.37 / ma, (mb - 1.0 + 0.37) / mb]] {
-                let (patch, facet);
-                let surf = if order == 0 {
-                    facet = FacetSurface::new(na, nb).unwrap();
-                    MasterSurface::Facet(&facet)
-                } else {
-                    patch = BSplinePatch::new(na, nb, order, order).unwrap();
-                    MasterSurface::BSpline(&patch)
-                };
+                let master = TestMaster::new(na, nb, order);
+                let surf = master.surface();
                 let x_all = curved_net(na, nb);
                 let (sp0, _) = surf.evaluate_local(&x_all, xi0);
                 let nodes = sp0.basis.nodes().to_vec();

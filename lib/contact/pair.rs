@@ -287,6 +287,16 @@ impl PairSolver {
         }
     }
 
+    /// λ_N + ε_N g_N of slave `s` at the last search (eq. 4.2): pressed when < 0.
+    fn trial(&self, s: usize) -> f64 {
+        self.lambda_n[s] + self.settings.eps_n * self.projections[s].g
+    }
+
+    /// Inside the patch and pressed into it at the last search.
+    fn pressed(&self, s: usize) -> bool {
+        self.usable(s) && self.trial(s) < 0.0
+    }
+
     fn normal_law(&self, s: usize) -> NormalLaw {
         NormalLaw { lambda_n: self.lambda_n[s], eps_n: self.settings.eps_n, area: self.areas[s], touch: self.touch }
     }
@@ -319,7 +329,7 @@ impl PairSolver {
                 self.status[s] = SlaveStatus::Outside;
                 continue;
             }
-            let trial = self.lambda_n[s] + self.settings.eps_n * self.projections[s].g; // eq. 4.2
+            let trial = self.trial(s);
             self.t_n[s] = trial.min(0.0);
             self.status[s] = if trial < 0.0 { SlaveStatus::Active } else { SlaveStatus::Open };
             if trial < 0.0 {
@@ -372,7 +382,7 @@ impl PairSolver {
     /// Number of slaves with a positive trial pressure at the last search (a cheap
     /// count for progress lines, before the states are updated).
     pub fn n_pressed(&self) -> usize {
-        (0..self.slaves.len()).filter(|&s| self.usable(s) && self.lambda_n[s] + self.settings.eps_n * self.projections[s].g < 0.0).count()
+        (0..self.slaves.len()).filter(|&s| self.pressed(s)).count()
     }
 
     /// The contact configuration at the last search, one entry per slave: whether it
@@ -380,7 +390,7 @@ impl PairSolver {
     /// changes when the active set or the master element under a node changes.
     pub fn configuration(&self, out: &mut Vec<(u32, bool, u32)>) {
         for s in 0..self.slaves.len() {
-            let pressed = self.usable(s) && self.lambda_n[s] + self.settings.eps_n * self.projections[s].g < 0.0;
+            let pressed = self.pressed(s);
             let first = if self.usable(s) { self.points[s].basis.nodes().first().map_or(u32::MAX, |&k| self.net[k]) } else { u32::MAX };
             out.push((self.slaves[s], pressed, first));
         }
@@ -478,11 +488,5 @@ impl PairSolver {
         self.xi_n.copy_from_slice(&self.xi_n_committed);
         self.t_t_n.copy_from_slice(&self.t_t_n_committed);
         self.augmentations = 0;
-    }
-
-    /// Restart: set the multipliers of the last converged increment.
-    pub fn set_committed(&mut self, lambda_n: &[f64]) {
-        self.lambda_committed.copy_from_slice(lambda_n);
-        self.lambda_n.copy_from_slice(lambda_n);
     }
 }

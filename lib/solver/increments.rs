@@ -128,6 +128,7 @@ fn contact_results(newton: &Newton) -> ContactResults {
     for c in &newton.contact {
         let f = c.total_force();
         let max_penetration = c.max_penetration();
+        let elastic_slip = c.max_elastic_slip();
         summaries.push(PairSummary {
             pair: c.name.clone(),
             force: [f[0], f[1], f[2]],
@@ -135,12 +136,12 @@ fn contact_results(newton: &Newton) -> ContactResults {
             max_penetration,
             augmentations: c.augmentations,
             penetration_converged: c.settings.enforcement == Enforcement::Penalty
-                || (max_penetration <= c.settings.penetration_tolerance && c.max_elastic_slip() <= c.settings.penetration_tolerance),
+                || (max_penetration <= c.settings.penetration_tolerance && elastic_slip <= c.settings.penetration_tolerance),
             unprojected: c.failed_projections().0 as u32,
             friction: c.settings.frictional().then(|| {
                 let t = c.tangential_force();
                 let (stick, slip) = c.n_stick_slip();
-                FrictionSummary { tangential_force: [t[0], t[1], t[2]], stick: stick as u32, slip: slip as u32, elastic_slip: c.max_elastic_slip() }
+                FrictionSummary { tangential_force: [t[0], t[1], t[2]], stick: stick as u32, slip: slip as u32, elastic_slip }
             }),
         });
         friction.push(if c.settings.frictional() {
