@@ -90,6 +90,15 @@ impl Projector {
             }
         }
     }
+    /// With the master element held (a frozen search): a facet slave projects onto
+    /// its last cell's continued bilinear map; a B-spline slave as usual (the patch
+    /// is one smooth map, there is no element to hold).
+    fn project_frozen(&self, p: &Vec3, prev: Option<[usize; 2]>) -> (Projection, Option<[usize; 2]>) {
+        match (self, prev) {
+            (Self::Facet(pr), Some(c)) => (pr.project_on_cell(p, c), Some(c)),
+            _ => self.project(p, prev),
+        }
+    }
     /// The closest point on the surface's extension beyond its edge (see
     /// [`BSplineProjector::project_extended`]).
     fn project_extended(&self, p: &Vec3, xi0: [f64; 2], cell: Option<[usize; 2]>, margin: [f64; 2]) -> Projection {
@@ -150,6 +159,8 @@ pub struct PairSolver {
     edge_tolerance: f64,
     /// Uzawa updates made in the current increment.
     pub augmentations: u32,
+    /// The search holds every slave's master element (see [`Self::freeze`]).
+    frozen: bool,
     /// Friction history (eq. 4.7): the converged foot point ξ̄_n and covariant
     /// tangential traction t_{Tα,n} of the last increment (zero when not in contact).
     xi_n: Vec<[f64; 2]>,
@@ -204,6 +215,7 @@ impl PairSolver {
             touch: 1e-8 * h_master,
             edge_tolerance: 1e-3 * h_master,
             augmentations: 0,
+            frozen: false,
             xi_n: vec![[f64::NAN; 2]; n],
             xi_n_committed: vec![[f64::NAN; 2]; n],
             t_t_n_committed: vec![[0.0; 2]; n],
@@ -223,6 +235,7 @@ impl PairSolver {
         self.projector.update(&self.x_net).map_err(|source| PairError::Master { pair: self.name.clone(), source })?;
         let projector = &self.projector;
         let edge_tolerance = self.edge_tolerance;
+        let frozen = self.frozen;
         self.x_slave.iter_mut().zip(&self.slaves).for_each(|(xs, &node)| *xs = x(node));
         self.projections
             .par_iter_mut()
@@ -231,7 +244,7 @@ impl PairSolver {
             .zip(self.x_slave.par_iter())
             .with_min_len(64)
             .for_each(|(((proj, sp), cell), xs)| {
-                let (pr, c) = projector.project(xs, *cell);
+                let (pr, c) = if frozen { projector.project_frozen(xs, *cell) } else { projector.project(xs, *cell) };
                 *proj = pr;
                 *cell = c;
                 if proj.converged {
@@ -259,6 +272,27 @@ impl PairSolver {
             }
         }
         Ok(())
+    }
+
+    /// Hold every slave's master element (facet cell) in the following searches, until
+    /// [`Self::release`]: the projection stays on that element's continued map. Newton
+    /// calls it when the configuration keeps changing (a slave flipping between the
+    /// facets of a crease makes the residual non-differentiable there and Newton
+    /// cycles); with the elements held, the remaining iterations see one smooth
+    /// residual and converge, and the next solve searches afresh (the "segment
+    /// update" limit of FEBio and others). B-spline masters have no elements to hold.
+    pub fn freeze(&mut self) {
+        self.frozen = true;
+    }
+
+    /// Let the search choose master elements again.
+    pub fn release(&mut self) {
+        self.frozen = false;
+    }
+
+    /// Whether the search can hold anything (facet masters).
+    pub fn can_freeze(&self) -> bool {
+        matches!(self.projector, Projector::Facet(_))
     }
 
     /// The slave has a foot point on the patch: inside, or beyond an edge by less

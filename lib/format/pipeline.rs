@@ -40,6 +40,8 @@ pub struct Pipeline {
 }
 
 /// One stage: a map with a single key naming the stage.
+// A pipeline holds a handful of stages, read once: the inline solve setup's size is no concern.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Stage {

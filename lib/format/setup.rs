@@ -177,6 +177,21 @@ pub struct NewtonSetup {
     /// so 1e-12 matches a residual tolerance of 1e-8.
     #[serde(default = "default_energy_tol")]
     pub energy_tolerance: f64,
+    /// Newton iterations in which the contact search may move a slave node to another
+    /// master element (facet); after them — or as soon as the contact configuration
+    /// cycles — the elements are held until the solve converges (0: never hold).
+    #[serde(default = "default_search_updates")]
+    pub search_updates: u32,
+    /// Backtracking line search: from the second correction of a solve on, a
+    /// correction that raises ‖R_f‖ is halved (up to `max_step_halvings` times; the
+    /// last one is taken if none lowers it).
+    #[serde(default = "default_true")]
+    pub line_search: bool,
+    /// A Newton correction that inverts an element (or, with `line_search`, raises
+    /// the residual) is halved up to this many times; an inverted element then cuts
+    /// the increment back.
+    #[serde(default = "default_step_halvings")]
+    pub max_step_halvings: u32,
 }
 
 fn default_max_iterations() -> u32 {
@@ -188,10 +203,26 @@ fn default_residual_tol() -> f64 {
 fn default_energy_tol() -> f64 {
     1e-12
 }
+fn default_search_updates() -> u32 {
+    10
+}
+fn default_true() -> bool {
+    true
+}
+fn default_step_halvings() -> u32 {
+    6
+}
 
 impl Default for NewtonSetup {
     fn default() -> Self {
-        Self { max_iterations: default_max_iterations(), residual_tolerance: default_residual_tol(), energy_tolerance: default_energy_tol() }
+        Self {
+            max_iterations: default_max_iterations(),
+            residual_tolerance: default_residual_tol(),
+            energy_tolerance: default_energy_tol(),
+            search_updates: default_search_updates(),
+            line_search: true,
+            max_step_halvings: default_step_halvings(),
+        }
     }
 }
 

@@ -89,6 +89,15 @@ pub struct Newton<'p> {
     pub pattern_rebuilds: u32,
     /// The symmetry the linear solver was set up for.
     symmetry: Symmetry,
+    /// Newton corrections halved because they inverted an element (all solves).
+    pub step_halvings: u32,
+    /// Corrections halved by the late iterations' line search (all solves).
+    pub line_search_steps: u32,
+    /// The iteration at which the current solve held the contact search's master
+    /// elements, and why ([`PairSolver::freeze`]); `None` while they may change.
+    pub frozen_at: Option<(u32, &'static str)>,
+    /// Solves that held their master elements (all solves).
+    pub frozen_solves: u32,
 }
 
 /// A converged increment's iteration history.
@@ -137,6 +146,10 @@ impl<'p> Newton<'p> {
             owners,
             pattern_rebuilds: 0,
             symmetry,
+            step_halvings: 0,
+            line_search_steps: 0,
+            frozen_at: None,
+            frozen_solves: 0,
         })
     }
 
@@ -168,6 +181,22 @@ impl<'p> Newton<'p> {
             AssemblyFailure::Contact(pair, s, error) => IncrementFailure::Contact { iteration: 0, pair: self.contact[pair].name.clone(), node_tag: self.contact[pair].slaves[s] as u64, error },
         })?;
         Ok((self.residual.clone(), self.pattern.col_ptr().to_vec(), self.pattern.row_idx().to_vec(), self.assembly.values().to_vec()))
+    }
+
+    /// Hold the master elements of every pair's search for the rest of this solve.
+    fn freeze_contact(&mut self, iteration: u32, why: &'static str) {
+        if self.frozen_at.is_some() || !self.contact.iter().any(|c| c.can_freeze()) {
+            return;
+        }
+        self.contact.iter_mut().for_each(PairSolver::freeze);
+        self.frozen_at = Some((iteration, why));
+        self.frozen_solves += 1;
+    }
+
+    /// Let the searches choose master elements again (at the start and end of a
+    /// solve; `frozen_at` keeps saying what the last solve did).
+    fn release_contact(&mut self) {
+        self.contact.iter_mut().for_each(PairSolver::release);
     }
 
     /// Slave nodes pressed into the master at the last search, over all pairs.
@@ -253,22 +282,67 @@ impl<'p> Newton<'p> {
         // contact configurations of the last three iterates, to detect a 2-cycle
         let mut configs: [Vec<(u32, bool, u32)>; 3] = Default::default();
         let mut cycling = 0u32;
+        self.release_contact();
+        self.frozen_at = None;
+        let dofs = &p.dofs;
+        let mut last_r_norm = f64::INFINITY;
         for iteration in 0..=self.settings.max_iterations {
-            let t = Instant::now();
-            self.contact_search(u, iteration)?;
-            let seconds_contact = t.elapsed().as_secs_f64();
-            let t = Instant::now();
-            self.assemble(u, lambda).map_err(|f| match f {
-                AssemblyFailure::Hex(element, error) => IncrementFailure::Element { iteration, element, error },
-                AssemblyFailure::Contact(pair, s, error) => {
-                    let c = &self.contact[pair];
-                    IncrementFailure::Contact { iteration, pair: c.name.clone(), node_tag: p.node_tags.get(c.slaves[s] as usize).copied().unwrap_or(c.slaves[s] as u64), error }
+            if self.settings.search_updates > 0 && iteration == self.settings.search_updates {
+                self.freeze_contact(iteration, "search_updates reached");
+            }
+            // From the second correction on, a correction that raises ‖R_f‖ is
+            // shortened (backtracking line search; the first follows the load step).
+            // (Contact problems only: a smooth large-strain solve converges faster
+            // with full steps, measured on the quadratic-rate test.)
+            let line_search = self.settings.line_search && !self.contact.is_empty() && iteration >= 2;
+            let (mut seconds_contact, mut seconds_assembly) = (0.0, 0.0);
+            let mut halvings = 0;
+            let r_norm = loop {
+                let t = Instant::now();
+                self.contact_search(u, iteration)?;
+                seconds_contact += t.elapsed().as_secs_f64();
+                let t = Instant::now();
+                let assembled = self.assemble(u, lambda);
+                seconds_assembly += t.elapsed().as_secs_f64();
+                let backtrack = match assembled {
+                    Ok(()) => {
+                        dofs.gather_free(&self.residual, &mut self.rhs);
+                        let r_norm = self.rhs.iter().map(|v| v * v).sum::<f64>().sqrt();
+                        // Line search: the full correction raised the residual; take a
+                        // shorter one (α = ½, ¼, …), or the last tried if none lowers it.
+                        if line_search && r_norm > last_r_norm && halvings < self.settings.max_step_halvings {
+                            self.line_search_steps += 1;
+                            true
+                        } else {
+                            break r_norm;
+                        }
+                    }
+                    // Step control: the correction inverted an element; go back half of
+                    // it and try again before giving the increment up.
+                    Err(AssemblyFailure::Hex(..)) if iteration > 0 && halvings < self.settings.max_step_halvings => {
+                        self.step_halvings += 1;
+                        true
+                    }
+                    Err(f) => {
+                        self.release_contact();
+                        return Err(match f {
+                            AssemblyFailure::Hex(element, error) => IncrementFailure::Element { iteration, element, error },
+                            AssemblyFailure::Contact(pair, s, error) => {
+                                let c = &self.contact[pair];
+                                IncrementFailure::Contact { iteration, pair: c.name.clone(), node_tag: p.node_tags.get(c.slaves[s] as usize).copied().unwrap_or(c.slaves[s] as u64), error }
+                            }
+                        });
+                    }
+                };
+                if backtrack {
+                    // u ← u − ½Δu (Δu, kept in r_free, halves)
+                    self.r_free.iter_mut().for_each(|d| *d *= -0.5);
+                    dofs.add_free(&self.r_free, u);
+                    self.r_free.iter_mut().for_each(|d| *d = -*d);
+                    halvings += 1;
                 }
-            })?;
-            let seconds_assembly = t.elapsed().as_secs_f64();
-            let dofs = &p.dofs;
-            dofs.gather_free(&self.residual, &mut self.rhs);
-            let r_norm = self.rhs.iter().map(|v| v * v).sum::<f64>().sqrt();
+            };
+            last_r_norm = r_norm;
             let reaction_norm = (0..self.residual.len()).filter(|&d| dofs.is_constrained(d)).map(|d| self.residual[d].powi(2)).sum::<f64>().sqrt();
             // Reference force: the external load, or the largest reaction seen in this
             // increment (a stress-free state, e.g. a prescribed rigid rotation, drives
@@ -313,6 +387,7 @@ impl<'p> Newton<'p> {
             if converged || r_norm == 0.0 {
                 on_iteration(&row);
                 log.push(row);
+                self.release_contact();
                 return Ok(Converged { iterations: log });
             }
             if iteration == self.settings.max_iterations {
@@ -334,7 +409,11 @@ impl<'p> Newton<'p> {
                 }
                 let two_cycle = iteration >= 2 && configs[0] == configs[2] && configs[0] != configs[1];
                 cycling = if two_cycle { cycling + 1 } else { 0 };
-                if cycling >= 3 {
+                if cycling >= 3 && self.settings.search_updates > 0 && self.frozen_at.is_none() && self.contact.iter().any(|c| c.can_freeze()) {
+                    // first remedy: hold the master elements and let Newton finish
+                    self.freeze_contact(iteration, "the contact configuration cycles");
+                    cycling = 0;
+                } else if cycling >= 3 {
                     let tags = &p.node_tags;
                     let flipping: Vec<String> = configs[0]
                         .iter()

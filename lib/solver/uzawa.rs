@@ -16,8 +16,18 @@ use crate::format::scres::IterationLog;
 pub fn solve_augmented(newton: &mut Newton, lambda: f64, u: &mut [f64], on_iteration: &mut dyn FnMut(&IterationLog), note: &mut dyn FnMut(&str)) -> Result<Converged, IncrementFailure> {
     let mut iterations = Vec::new();
     loop {
+        let (halvings, searched) = (newton.step_halvings, newton.line_search_steps);
         let conv = newton.solve_increment(lambda, u, on_iteration)?;
         iterations.extend(conv.iterations);
+        if let Some((iteration, why)) = newton.frozen_at {
+            note(&format!("master elements held from iteration {iteration} ({why})"));
+        }
+        if newton.step_halvings > halvings {
+            note(&format!("{} Newton corrections halved (an element inverted)", newton.step_halvings - halvings));
+        }
+        if newton.line_search_steps > searched {
+            note(&format!("line search: {} corrections halved", newton.line_search_steps - searched));
+        }
         let mut due = false;
         let node_tags = &newton.problem.node_tags;
         for pair in &mut newton.contact {

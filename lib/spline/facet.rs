@@ -205,13 +205,60 @@ impl FacetProjector {
                 cell = c;
             }
         }
+        // Dead zone: the closest point lies on an interior crease, where no facet has
+        // an orthogonal projection (a point below a concave crease, above a convex
+        // one); the gap there is not differentiable and its linearization (eq. 6.5)
+        // does not hold. With a kept facet (a search that follows a node), continue
+        // its plane (its bilinear map beyond its edge) until the node reaches the
+        // orthogonal range of a neighbour; without one, the closest point stands.
+        if let Some(kept) = prev.filter(|_| self.on_interior_crease(p, &res)) {
+            for c in [kept, cell] {
+                let ext = self.newton_on_cell_map(p, c);
+                if ext.converged && self.orthogonal(p, &ext) {
+                    res = ext;
+                    cell = c;
+                    break;
+                }
+            }
+        }
         (finish(p, &res, self.options.outside_tol * self.scale), cell)
+    }
+
+    /// Whether the foot point satisfies the closest-point condition (p − x̄)·ā_α = 0
+    /// in each direction α (not held on a box bound).
+    fn orthogonal_in(&self, p: &Vec3, res: &NewtonResult) -> [bool; 2] {
+        let d = p - res.jet.x;
+        let tol = self.options.tol * self.scale;
+        [0, 1].map(|al| d.dot(&res.jet.a[al]).abs() <= (1e-8 * d.norm() + 8.0 * tol) * res.jet.a[al].norm())
+    }
+
+    fn orthogonal(&self, p: &Vec3, res: &NewtonResult) -> bool {
+        self.orthogonal_in(p, res).iter().all(|&o| o)
+    }
+
+    /// The foot point is held on a cell edge shared with another cell (a bound in a
+    /// direction where ξ is not on the patch's edge).
+    fn on_interior_crease(&self, p: &Vec3, res: &NewtonResult) -> bool {
+        let ortho = self.orthogonal_in(p, res);
+        res.converged && (0..2).any(|al| !ortho[al] && res.xi[al] > 1e-12 && res.xi[al] < 1.0 - 1e-12)
+    }
+
+    /// Bounded Newton on `cell`'s bilinear map continued one cell width beyond each edge.
+    fn newton_on_cell_map(&self, p: &Vec3, cell: [usize; 2]) -> NewtonResult {
+        let (mut lo, mut hi) = self.facets.cell_bounds(cell);
+        let width = [hi[0] - lo[0], hi[1] - lo[1]];
+        for al in 0..2 {
+            lo[al] -= width[al];
+            hi[al] += width[al];
+        }
+        let o = &self.options;
+        let mid = [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])];
+        newton(|xi| self.facets.jet_in_cell(&self.x, cell, xi), p, mid, (lo, hi), [hi[0] - lo[0], hi[1] - lo[1]], o.tol * self.scale, o.max_iterations)
     }
 
     /// Closest point on `cell`'s bilinear map extended beyond the patch edge by up to
     /// `margin` (parameter units) — see [`crate::spline::BSplineProjector::project_extended`].
     pub fn project_extended(&self, p: &Vec3, cell: [usize; 2], margin: [f64; 2]) -> Projection {
-        let o = &self.options;
         let (mut lo, mut hi) = self.facets.cell_bounds(cell);
         let n = self.facets.n_cells();
         for al in 0..2 {
@@ -222,6 +269,22 @@ impl FacetProjector {
                 hi[al] += margin[al];
             }
         }
+        self.project_on_map(p, cell, lo, hi)
+    }
+
+    /// Closest point on `cell`'s bilinear map continued over one cell width beyond
+    /// each of its edges: the projection with the master element held fixed (a
+    /// frozen search, see `PairSolver::freeze`). Across a crease the foot point then
+    /// moves on the continued plane of its facet instead of jumping to the
+    /// neighbour's, so the contact residual stays differentiable while Newton
+    /// finishes the iterate.
+    pub fn project_on_cell(&self, p: &Vec3, cell: [usize; 2]) -> Projection {
+        finish(p, &self.newton_on_cell_map(p, cell), self.options.outside_tol * self.scale)
+    }
+
+    /// Bounded Newton on `cell`'s bilinear map over ξ ∈ [lo, hi].
+    fn project_on_map(&self, p: &Vec3, cell: [usize; 2], lo: [f64; 2], hi: [f64; 2]) -> Projection {
+        let o = &self.options;
         let mid = [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])];
         let res = newton(|xi| self.facets.jet_in_cell(&self.x, cell, xi), p, mid, (lo, hi), [hi[0] - lo[0], hi[1] - lo[1]], o.tol * self.scale, o.max_iterations);
         finish(p, &res, o.outside_tol * self.scale)

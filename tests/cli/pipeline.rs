@@ -81,3 +81,33 @@ fn pipeline_stops_at_first_failing_stage() {
     assert_fails(&o, 1, &["stage 1 (import) failed", "missing.msh"], &dir.path().join("pipelines/out/a.scmesh"));
     assert!(!stderr(&o).contains("[2/2]"), "second stage must not run");
 }
+
+/// Every shipped pipeline parses (stage keys, setups, aliases) and the meshes its
+/// import stages read are in the repository: the long benchmark pipelines (ironing)
+/// are not run by the tests, but a typo in them is caught here.
+#[test]
+fn every_shipped_pipeline_parses_and_finds_its_meshes() {
+    use splinecontact::format::pipeline::{resolve, Pipeline, Stage};
+    let dir = repo().join("pipelines");
+    let mut n = 0;
+    for e in std::fs::read_dir(&dir).unwrap() {
+        let path = e.unwrap().path();
+        if path.extension().is_none_or(|x| x != "yaml") {
+            continue;
+        }
+        let p = Pipeline::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let mut meshed = Vec::new();
+        for stage in &p.stages {
+            match stage {
+                Stage::Gmsh(s) => meshed.push(resolve(&dir, &s.output)),
+                Stage::Import(s) => {
+                    let msh = resolve(&dir, &s.input);
+                    assert!(msh.is_file() || meshed.contains(&msh), "{}: imports {} which is not in the repository", path.display(), msh.display());
+                }
+                _ => {}
+            }
+        }
+        n += 1;
+    }
+    assert!(n >= 14, "found {n} pipelines");
+}

@@ -7,6 +7,7 @@
 use std::path::Path;
 
 use crate::common::{python_script, repo, run, stderr, tempdir};
+use splinecontact::format::scres::Results;
 
 fn staged(pipeline: &str) -> tempfile::TempDir {
     let dir = tempdir();
@@ -80,7 +81,9 @@ fn curved_master_bspline_against_facets() {
     let cases = [
         ("B-spline [3,3]", &runs[0], 1583.547, 40.0, 0.248),
         ("B-spline [4,4]", &runs[1], 1483.790, 27.0, 0.443),
-        ("facet, nby 3", &runs2[0], 1631.366, 35.0, 0.845),
+        // 35 before the line search (2026-11-23), 46 with it: the facets' residual
+        // rises at every crease crossing and the search shortens those steps
+        ("facet, nby 3", &runs2[0], 1631.366, 46.0, 0.845),
         ("B-spline [3,3], nby 3", &runs2[1], 1623.349, 29.0, 0.239),
     ];
     for (label, j, fz, newton, d2) in cases {
@@ -104,10 +107,13 @@ fn curved_master_bspline_against_facets() {
 }
 
 /// The facet master on the shipped curved mesh: a pad node sits over a concave crease
-/// of the indented base, where node-to-facet contact has no equilibrium (see
-/// curved-facet.yaml). Newton must say so — a period-2 cycle of the contact
+/// of the indented base, where plain node-to-facet contact has no equilibrium (see
+/// curved-facet.yaml). Without the stabilisation (`newton: {search_updates: 0,
+/// line_search: false}`) Newton must say so — a period-2 cycle of the contact
 /// configuration, naming the node — instead of iterating to the limit, and the solve
-/// stops with exit code 3 after its cutbacks.
+/// stops with exit code 3 after its cutbacks. With it (the default: facets held on
+/// their continued planes, line search) the same solve converges (measured: 5
+/// increments, 80 Newton iterations, no cutback).
 #[test]
 fn facet_on_a_concave_crease_reports_the_cycling_node() {
     let dir = tempdir();
@@ -118,11 +124,21 @@ fn facet_on_a_concave_crease_reports_the_cycling_node() {
 constraints:\n  - {set: base_bottom, fix: [x, y, z]}\n  - {set: pad_top, fix: [x, y], displacement: {z: -0.4}}\n\
 contact:\n  - {pair: contact, eps_n: 1.0e5, enforcement: augmented_lagrangian, penetration_tolerance: 1.0e-5}\n\
 increments: {count: 5, max_cutbacks: 1}\n";
-    std::fs::write(dir.path().join("s.yaml"), setup).unwrap();
+    std::fs::write(dir.path().join("s.yaml"), format!("{setup}newton: {{search_updates: 0, line_search: false}}\n")).unwrap();
     let o = run("sc-solve", &["c.sccontact", "--setup", "s.yaml", "-o", "r.scres"], dir.path());
     let err = stderr(&o);
     assert_eq!(o.status.code(), Some(3), "{err}");
     assert!(err.contains("the contact configuration cycles between two states") && err.contains("slave nodes 168"), "{err}");
     // within a few iterations, not at max_iterations
     assert!(!err.contains("did not converge in 25 iterations"), "{err}");
+    // stabilised (the defaults): converges, every increment, no cutback
+    std::fs::write(dir.path().join("s2.yaml"), setup).unwrap();
+    let o = run("sc-solve", &["c.sccontact", "--setup", "s2.yaml", "-o", "r2.scres"], dir.path());
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    let r = Results::read(&dir.path().join("r2.scres")).unwrap();
+    assert_eq!(r.increments.len(), 5);
+    assert_eq!(r.increments.iter().map(|i| i.info.cutbacks).sum::<u32>(), 0);
+    let its: usize = r.increments.iter().map(|i| i.info.iterations.len() - 1).sum();
+    assert!(its <= 100, "{its} Newton corrections (measured 80)");
 }

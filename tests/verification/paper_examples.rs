@@ -27,7 +27,8 @@ fn max_displacement(r: &Results) -> (f64, u64) {
     (u, r.mesh.node_tags[i])
 }
 
-/// Pinned (2026-11-23): max |u| and its node, and the Newton corrections of the
+/// Pinned (2026-11-23; the crossed beams again after the line search came in, which
+/// took their first increment from 4 cutbacks to none): max |u| and its node, and the Newton corrections of the
 /// converged attempts. Tolerance 1e-5 relative on |u|: Newton stops at 1e-8 relative
 /// residual and the augmented Lagrangian at 1e-3 mm penetration on beams whose
 /// contact compliance is ε_N A_s ≥ 1e8 N/mm, so a rerun reproduces |u| to ~1e-8; 1e-5
@@ -35,11 +36,13 @@ fn max_displacement(r: &Results) -> (f64, u64) {
 #[test]
 fn paper_examples_are_pinned() {
     // (pipeline, max |u|, node tag, Newton corrections of converged attempts)
-    let pins: [(&str, f64, u64, usize); 4] = [
-        ("parisch", 0.05028862, 20, 2),
-        ("crossed_beams", 1.11427661, 15, 22),
-        ("parallel_beams", 0.33898814, 91, 95),
-        ("supported_beam", 0.79809336, 16, 84),
+    // The parallel beams are symmetric: nodes 87 and 91 share the largest |u| to 8
+    // digits, and which one wins depends on the last bits of the Newton path.
+    let pins: [(&str, f64, &[u64], usize); 4] = [
+        ("parisch", 0.05028862, &[20], 2),
+        ("crossed_beams", 1.11427651, &[15], 19),
+        ("parallel_beams", 0.33898814, &[87, 91], 95),
+        ("supported_beam", 0.79809336, &[16], 84),
     ];
     for (name, u_pin, tag_pin, its_pin) in pins {
         let r = run_pipeline(name);
@@ -49,7 +52,7 @@ fn paper_examples_are_pinned() {
         let cutbacks: u32 = r.increments.iter().map(|i| i.info.cutbacks).sum();
         eprintln!("{name}: max |u| = {u:.8} at node {tag}, {} increments, {its} Newton corrections, {cutbacks} cutbacks", r.increments.len());
         assert!((u - u_pin).abs() < 1e-5 * u_pin, "{name}: max |u| {u} vs pinned {u_pin}");
-        assert_eq!(tag, tag_pin, "{name}: the largest displacement moved to another node");
+        assert!(tag_pin.contains(&tag), "{name}: the largest displacement moved to node {tag} (pinned {tag_pin:?})");
         assert!(its as f64 <= 1.25 * its_pin as f64 + 1.0, "{name}: {its} Newton corrections (pinned {its_pin})");
         if name == "crossed_beams" {
             // the cantilever slides on the lower beam's edge at the end: every sliding
