@@ -8,7 +8,7 @@
 //! ## Crate map
 //! | module   | what it holds |
 //! |----------|---------------|
-//! | `format` | on-disk formats: stage container, `.scmesh`, gmsh MSH, VTK, pipeline YAML |
+//! | `format` | on-disk formats: stage container, `.scmesh`, gmsh MSH, VTK, pipeline YAML, the solver's CSV tables |
 //! | `mesh`   | the mesh: nodes, hex8, bodies, node and face sets, hex8 topology |
 //! | `contact` | contact pairs: a master face set ordered into the B-spline control net |
 //! | `spline` | the B-spline master patch and its bilinear-facet counterpart |

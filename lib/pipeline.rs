@@ -98,6 +98,16 @@ pub fn run(path: &Path, verbosity: Verbosity, log: &mut dyn FnMut(&str)) -> Resu
                 let msg = stages::export::export(&input, &out, s.format).map_err(fail)?;
                 log(&format!("      {msg}"));
             }
+            Stage::Plot(s) => {
+                let out = resolve(&base, &s.output);
+                let inputs: std::collections::BTreeSet<String> =
+                    s.panels.iter().flat_map(|p| p.series.iter().map(|q| resolve(&base, &q.input).display().to_string())).collect();
+                let inputs: Vec<String> = inputs.into_iter().collect();
+                log(&format!("[{index}/{n}] plot {} -> {}", inputs.join(", "), out.display()));
+                ensure_parent(&out).map_err(fail)?;
+                let msg = stages::plot::plot(s, &base).map_err(|e| fail(e.into()))?;
+                log(&format!("      {msg}"));
+            }
         }
     }
     log("pipeline finished");

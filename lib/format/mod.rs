@@ -1,6 +1,8 @@
 //! Every on-disk format, and nothing numerical: the versioned stage container,
-//! the mesh stage file, gmsh's MSH, VTK output and the pipeline YAML.
+//! the mesh stage file, gmsh's MSH, VTK output, the pipeline YAML and the CSV
+//! tables `sc-solve` writes.
 
+pub mod csv;
 pub mod msh;
 pub mod pipeline;
 pub mod sccontact;

@@ -10,6 +10,9 @@
 //!       output: out/parisch.sccontact
 //!       pairs: [{name: contact, slave: upper_bottom, master: lower_top, master_kind: bspline, orders: [3, 3]}]
 //!   - export: { input: out/parisch.scmesh, output: out/parisch.vtu }
+//!   - plot:
+//!       output: out/parisch_forces.png
+//!       panels: [{series: [{input: out/parisch.forces.csv, column: "contact:contact:z"}]}]
 //! ```
 //! Every struct denies unknown keys, so a misspelt key is an error that names it
 //! and its line (serde_yaml reports `at line L column C`).
@@ -21,6 +24,7 @@ use serde::Deserialize;
 use crate::stages::export::ExportFormat;
 use crate::format::setup::SolveSetup;
 use crate::stages::gmsh::MshFlavour;
+use crate::stages::plot::PlotSpec;
 use crate::stages::tag::PairSpec;
 
 /// The pipeline versions this build reads.
@@ -50,6 +54,8 @@ pub enum Stage {
     Tag(TagStage),
     Solve(SolveStage),
     Export(ExportStage),
+    /// Force-history CSVs → a PNG line plot; the keys are [`PlotSpec`]'s.
+    Plot(PlotSpec),
 }
 
 impl Stage {
@@ -60,6 +66,7 @@ impl Stage {
             Self::Tag(_) => "tag",
             Self::Solve(_) => "solve",
             Self::Export(_) => "export",
+            Self::Plot(_) => "plot",
         }
     }
 }
@@ -192,6 +199,36 @@ mod tests {
         let bad = y.replace("master_kind: facet", "master_kind: nurbs");
         let e = Pipeline::parse("p.yaml", &bad).unwrap_err().to_string();
         assert!(e.contains("nurbs") && e.contains("line 7"), "{e}");
+    }
+
+    #[test]
+    fn plot_stage_parses() {
+        let y = r#"version: 1
+stages:
+  - plot:
+      output: out/forces.png
+      title: "Shallow ironing, mu = 0.3"
+      x_label: "pseudo-time t"
+      size: [1000, 700]
+      x_range: [1.0, 2.0]
+      panels:
+        - y_label: "V [N/mm]"
+          series:
+            - {input: out/a.forces.csv, column: "reaction:indenter_top:y", scale: -1.0, label: "facet"}
+        - y_label: "H/V"
+          series:
+            - {input: out/a.forces.csv, column: "reaction:indenter_top:x", divide_by: "reaction:indenter_top:y"}
+"#;
+        let p = Pipeline::parse("p.yaml", y).unwrap();
+        let Stage::Plot(s) = &p.stages[0] else { panic!("not a plot stage") };
+        assert_eq!((s.x.as_str(), s.size, s.x_range), ("load_factor", Some([1000, 700]), Some([1.0, 2.0])));
+        assert_eq!(s.panels.len(), 2);
+        assert_eq!(s.panels[0].series[0].scale, -1.0);
+        let h = &s.panels[1].series[0];
+        assert_eq!((h.scale, h.divide_by.as_deref(), h.label.as_deref()), (1.0, Some("reaction:indenter_top:y"), None));
+        let bad = y.replace("divide_by:", "divde_by:");
+        let e = Pipeline::parse("p.yaml", &bad).unwrap_err().to_string();
+        assert!(e.contains("divde_by") && e.contains("line 15"), "{e}");
     }
 
     #[test]

@@ -5,6 +5,7 @@
 pub mod export;
 pub mod gmsh;
 pub mod import;
+pub mod plot;
 pub mod solve;
 pub mod tag;
 
@@ -15,6 +16,7 @@ use crate::solver::newton::SetupFailure;
 use crate::solver::problem::ProblemError;
 use crate::format::stage::StageError;
 use crate::format::vtk::VtkError;
+use plot::PlotError;
 use tag::TagError;
 
 /// Exit codes shared by every binary (ripgrep style): 0 success, 1 an I/O or
@@ -46,6 +48,8 @@ pub enum StageRunError {
     Solve(#[from] SolveError),
     #[error(transparent)]
     Tag(#[from] TagError),
+    #[error(transparent)]
+    Plot(#[from] PlotError),
     #[error("{0}")]
     Usage(String),
     #[error("{0}")]
@@ -62,6 +66,7 @@ impl StageRunError {
             | Self::Solve(SolveError::Write(StageError::Io { .. }))
             | Self::Tool(_) => exit_code::IO,
             Self::Solve(SolveError::Diverged { .. }) => exit_code::DIVERGED,
+            Self::Plot(e) => e.exit_code(),
             _ => exit_code::BAD_INPUT,
         }
     }

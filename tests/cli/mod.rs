@@ -1,5 +1,6 @@
 mod bad_input;
 mod import_export;
 mod pipeline;
+mod plot;
 mod solve;
 mod tag;

@@ -18,6 +18,7 @@ pub fn run(bin: &str, args: &[&str], dir: &Path) -> Output {
         "sc-pipeline" => env!("CARGO_BIN_EXE_sc-pipeline"),
         "sc-solve" => env!("CARGO_BIN_EXE_sc-solve"),
         "sc-tag" => env!("CARGO_BIN_EXE_sc-tag"),
+        "sc-plot" => env!("CARGO_BIN_EXE_sc-plot"),
         other => panic!("unknown binary {other}"),
     };
     Command::new(exe).args(args).current_dir(dir).output().expect("binary runs")
