@@ -1,7 +1,7 @@
 // 3D ironing after Puso & Laursen 2004 (CMAME 193, "A mortar segment-to-segment
 // frictional contact method for large deformations"; benchmarks.md, "3D ironing"):
 // a stiff half-cylindrical die pressed into a soft slab, then dragged along it over
-// eight master element lengths. Units are consistent but arbitrary (E = 1 for the slab).
+// about nine master element lengths. Units are consistent but arbitrary (E = 1 for the slab).
 // Dimensions (as published):
 //   slab  x in [0, 9] (sliding direction), y in [0, 4] (width), z in [0, 3]; bottom fixed
 //   die   a half-cylindrical shell, axis along y at x = 2.5, z = 6 (so its lowest line
@@ -13,16 +13,22 @@
 //   4 to x = 6.5, stays over the slab (its contact zone, half-width ~2.5, then spans
 //   x ~ 0..5 and ~4..9).
 // Mesh (hex8, transfinite, recombined):
-//   slab  nsx x nsy x nsz = 18 x 8 x 6 (element length 0.5): its top face slab_top is
-//         a 19 x 9 node net, the master (one B-spline patch or 18 x 8 facets)
-//   die   ndt x ndy x 1 = 36 x 8 x 1 (the half circle split uniformly in angle: arc
-//         length 0.26 on the outer face; 0.65 along y; one element through the 0.2
-//         thickness): its outer face die_outer (37 x 9 nodes) is the slave. Its node
-//         rows along y sit at -0.6, 0.05, ..., 3.95, 4.6: 0.6 beyond the slab's sides
-//         or 0.05 inside them. With ndy = 10 rows sit 0.08 outside; the slab's top
-//         edges bulge outward under the die, the master patch grows under those
-//         rows, already penetrated, and their force switches on with a jump:
-//         Newton then cycles (measured: 49 <-> 51 active nodes at t = 0.26).
+//   slab  nsx x nsy x nsz = 20 x 7 x 6 (elements 0.45 x 0.571 x 0.5): its top face
+//         slab_top is a 21 x 8 node net, the master (one B-spline patch or 20 x 7
+//         facets). No slab node row lies under a die node row at the start: with
+//         18 x 8 (0.5 x 0.5) the die's lowest row (x = 2.5) and its middle row
+//         (y = 2) sat exactly on master node rows — on facet creases, where a node
+//         pressed straight down flips between the two facets at every iterate.
+//   die   ndt x ndy x 1 = 36 x 6 x 1 (the half circle split uniformly in angle: arc
+//         length 0.26 on the outer face; 0.87 along y; one element through the 0.2
+//         thickness): its outer face die_outer (37 x 7 nodes) is the slave. Its node
+//         rows along y sit at -0.6, 0.267, 1.133, 2, 2.867, 3.733, 4.6: 0.6 beyond the
+//         slab's sides or 0.27 inside them. A slave row near the master's edge crosses
+//         it while the slab deforms, already penetrated, and its force switches on or
+//         off with a jump: Newton then cycles. Measured: rows 0.08 outside (ndy = 10)
+//         cycled 49 <-> 51 active nodes at t = 0.26 (the top edges bulge outward early);
+//         rows 0.05 inside (ndy = 8) left the patch at t = 0.96 (the top edges are
+//         drawn inward under the die late in the pressing).
 // Sets: slab (volume), die (volume), slab_bottom (fixed), slab_top (master),
 //   die_outer (slave), die_top (the two straight edge faces of the shell at z = 6:
 //   prescribed u_x, u_z, u_y = 0).
@@ -31,11 +37,11 @@
 Mesh.MshFileVersion = 4.1;
 
 DefineConstant[
-  nsx = {18, Name "Parameters/nsx"},      // slab elements along x (sliding)
-  nsy = {8, Name "Parameters/nsy"},       // slab elements along y (width)
+  nsx = {20, Name "Parameters/nsx"},      // slab elements along x (sliding; see below)
+  nsy = {7, Name "Parameters/nsy"},       // slab elements along y (width; see below)
   nsz = {6, Name "Parameters/nsz"},       // slab elements through its thickness
   ndt = {36, Name "Parameters/ndt"},      // die elements around its half circle
-  ndy = {8, Name "Parameters/ndy"}        // die elements along its axis (see below)
+  ndy = {6, Name "Parameters/ndy"}        // die elements along its axis (see below)
 ];
 
 xc = 2.5;   // die axis, x

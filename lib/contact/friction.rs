@@ -42,6 +42,9 @@ pub struct FrictionLaw {
     pub xi_n: [f64; 2],
     /// Converged covariant tangential traction t_{Tα,n} (zero if the node was not in contact).
     pub t_t_n: [f64; 2],
+    /// The return mapping's branch held by the solver (`Some(true)`: slip), or `None`:
+    /// chosen by the slip criterion (eq. 4.8). See `PairSolver::freeze`.
+    pub held_slip: Option<bool>,
 }
 
 /// Outcome of one frictional slave-node evaluation.
@@ -183,7 +186,7 @@ fn evaluate(
         let tr = [0, 1].map(|al| Dual::cst(friction.t_t_n[al]) + (met[al][0] * slip_xi[0] + met[al][1] * slip_xi[1]) * friction.eps_t);
         let norm2 = tr[0] * met_inv[0][0] * tr[0] + tr[0] * met_inv[0][1] * tr[1] + tr[1] * met_inv[1][0] * tr[0] + tr[1] * met_inv[1][1] * tr[1];
         let limit = -t_n * friction.mu; // μ|t_N|, t_N < 0
-        let slip = norm2.v > 0.0 && norm2.v.sqrt() > limit.v;
+        let slip = norm2.v > 0.0 && friction.held_slip.unwrap_or(norm2.v.sqrt() > limit.v);
         let t_t = if slip {
             let nrm = norm2.sqrt();
             [tr[0] * limit / nrm, tr[1] * limit / nrm]
@@ -269,7 +272,7 @@ mod tests {
                 // zero tangential traction must reproduce the analytical frictionless K
                 for (eps_t, mu, want_slip) in [(1e3, 0.3, true), (5.0, 0.3, false), (0.0, 0.3, false)] {
                     let t_t_n = if eps_t == 0.0 { [0.0; 2] } else { [0.05, -0.02] };
-                    let fr = FrictionLaw { mu, eps_t, xi_n: back, t_t_n };
+                    let fr = FrictionLaw { mu, eps_t, xi_n: back, t_t_n, held_slip: None };
                     let (mut r, mut k) = (DVector::zeros(0), DMatrix::zeros(0, 0));
                     let st = frictional_contact(&xs0, &sp0, &normal, &fr, &mut r, &mut k).unwrap();
                     assert!(st.active);
@@ -305,7 +308,7 @@ mod tests {
         let xs = sp.x_bar - sp.n_bar * 0.01;
         let normal = NormalLaw { lambda_n: 0.0, eps_n: 1e3, area: 2.0, touch: 0.0 };
         // the slave has moved +x relative to where it stuck: ξ_n behind in ξ¹
-        let fr = FrictionLaw { mu: 0.3, eps_t: 1e6, xi_n: [0.49, 0.5], t_t_n: [0.0; 2] };
+        let fr = FrictionLaw { mu: 0.3, eps_t: 1e6, xi_n: [0.49, 0.5], t_t_n: [0.0; 2], held_slip: None };
         let (mut r, mut k) = (DVector::zeros(0), DMatrix::zeros(0, 0));
         let st = frictional_contact(&xs, &sp, &normal, &fr, &mut r, &mut k).unwrap();
         assert!(st.slip);

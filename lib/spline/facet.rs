@@ -199,7 +199,13 @@ impl FacetProjector {
         let (d2, mut res, mut cell) = best.expect("the tree has at least one cell");
         if let Some(c) = prev.filter(|&c| c != cell) {
             let kept = self.in_cell(p, c);
-            let slack = 1e-6 * self.scale;
+            // Where the orthogonal ranges of two facets overlap (a penetrating node
+            // near a concave crease) both foot points are local closest points whose
+            // distances differ by little; keeping the previous one while it is within
+            // 1e-4 of the net's size stops the node from switching facets (and its gap
+            // from jumping) at every Newton iterate. A foot point held on the cell's
+            // edge is kept only within round-off.
+            let slack = if self.orthogonal(p, &kept) { 1e-4 * self.scale } else { 1e-6 * self.scale };
             if kept.converged && (p - kept.jet.x).norm() <= d2.sqrt() + slack {
                 res = kept;
                 cell = c;
@@ -243,13 +249,15 @@ impl FacetProjector {
         res.converged && (0..2).any(|al| !ortho[al] && res.xi[al] > 1e-12 && res.xi[al] < 1.0 - 1e-12)
     }
 
-    /// Bounded Newton on `cell`'s bilinear map continued one cell width beyond each edge.
+    /// Bounded Newton on `cell`'s bilinear map continued one cell width beyond each
+    /// edge it shares with another cell (not beyond the patch's edges: a node there is
+    /// outside, or within the edge tolerance, `PairSolver::search`).
     fn newton_on_cell_map(&self, p: &Vec3, cell: [usize; 2]) -> NewtonResult {
         let (mut lo, mut hi) = self.facets.cell_bounds(cell);
         let width = [hi[0] - lo[0], hi[1] - lo[1]];
         for al in 0..2 {
-            lo[al] -= width[al];
-            hi[al] += width[al];
+            lo[al] = (lo[al] - width[al]).max(0.0);
+            hi[al] = (hi[al] + width[al]).min(1.0);
         }
         let o = &self.options;
         let mid = [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])];
@@ -273,13 +281,23 @@ impl FacetProjector {
     }
 
     /// Closest point on `cell`'s bilinear map continued over one cell width beyond
-    /// each of its edges: the projection with the master element held fixed (a
+    /// each of its interior edges: the projection with the master element held fixed (a
     /// frozen search, see `PairSolver::freeze`). Across a crease the foot point then
     /// moves on the continued plane of its facet instead of jumping to the
     /// neighbour's, so the contact residual stays differentiable while Newton
     /// finishes the iterate.
-    pub fn project_on_cell(&self, p: &Vec3, cell: [usize; 2]) -> Projection {
-        finish(p, &self.newton_on_cell_map(p, cell), self.options.outside_tol * self.scale)
+    ///
+    /// A node that has left the continued map's range (its foot point held on the
+    /// range's bound: it moved more than a cell away) is not held: it gets the
+    /// regular search, as a held node could otherwise pass undetected through
+    /// another facet.
+    pub fn project_on_cell(&self, p: &Vec3, cell: [usize; 2]) -> (Projection, [usize; 2]) {
+        let res = self.newton_on_cell_map(p, cell);
+        if res.converged && self.orthogonal(p, &res) {
+            (finish(p, &res, self.options.outside_tol * self.scale), cell)
+        } else {
+            self.project_keeping(p, Some(cell))
+        }
     }
 
     /// Bounded Newton on `cell`'s bilinear map over ξ ∈ [lo, hi].

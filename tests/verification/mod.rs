@@ -4,3 +4,4 @@ mod parisch;
 mod benchmarks;
 mod friction;
 mod paper_examples;
+mod ironing;

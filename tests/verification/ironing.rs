@@ -1,0 +1,169 @@
+//! Large sliding: the 3D ironing pipelines (pipelines/ironing3d.yaml, μ = 0.3, and
+//! ironing3d_frictionless.yaml; mesh meshes/ironing3d.geo) run as shipped, each with
+//! the facet, B-spline [3, 3] and B-spline [4, 4] masters on the same mesh and load
+//! path, and their plot stage. Pinned: the force-history oscillation over the steady
+//! sliding phase (benchmarks.md's metric: RMS about a one-element moving average,
+//! relative to the mean vertical force), the friction ratio, and the Newton
+//! iterations and cutbacks of every master. docs/validation.md, "3D ironing", has
+//! the table these numbers come from.
+
+use std::path::Path;
+
+use splinecontact::format::csv::Table;
+use splinecontact::format::scres::{Results, RunStatus};
+use splinecontact::post::oscillation::oscillation;
+
+use crate::common::{repo, run, stderr, tempdir};
+
+/// The die slides 4 over t ∈ [1, 2]; the slab's element length along x is 9 / 20.
+const TRAVEL: f64 = 4.0;
+const ELEMENT: f64 = 0.45;
+/// Steady sliding: the travel [1, 3] (the contact zone, ~1.5 wide, is clear of the
+/// slab's ends and of the start of sliding).
+const STEADY: (f64, f64) = (1.0, 3.0);
+
+/// One master's histories: travel s = 4 (t − 1), V, H, tangential / normal contact force.
+struct History {
+    s: Vec<f64>,
+    v: Vec<f64>,
+    h: Vec<f64>,
+    t_over_n: Vec<f64>,
+}
+
+fn history(path: &Path) -> History {
+    let t = Table::read(path).unwrap();
+    let col = |n: &str| t.column(n).unwrap_or_else(|| panic!("{}: no column {n}", path.display()));
+    let (lf, rz, rx) = (col("load_factor"), col("reaction:die_top:z"), col("reaction:die_top:x"));
+    let (c, tg) = ([0, 1, 2].map(|k| col(&format!("contact:contact:{}", ["x", "y", "z"][k]))), [0, 1, 2].map(|k| col(&format!("tangential:contact:{}", ["x", "y", "z"][k]))));
+    let mut h = History { s: vec![], v: vec![], h: vec![], t_over_n: vec![] };
+    for r in t.rows.iter().filter(|r| r[lf] >= 1.0 - 1e-9) {
+        h.s.push(TRAVEL * (r[lf] - 1.0));
+        h.v.push(-r[rz]);
+        h.h.push(r[rx]);
+        let tv = tg.map(|k| r[k]);
+        let nv = [0, 1, 2].map(|k| r[c[k]] - tv[k]);
+        let norm = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        h.t_over_n.push(norm(tv) / norm(nv));
+    }
+    h
+}
+
+/// RMS of the horizontal force about its one-element moving average, relative to the
+/// mean vertical force (H itself is near zero when frictionless).
+fn h_ripple(h: &History) -> f64 {
+    let o = oscillation(&h.s, &h.h, ELEMENT, STEADY.0, STEADY.1).unwrap();
+    let v = oscillation(&h.s, &h.v, ELEMENT, STEADY.0, STEADY.1).unwrap();
+    o.rms * o.mean.abs() / v.mean
+}
+
+/// Run a shipped pipeline in a copy of meshes/ and pipelines/; the histories and
+/// results of its three masters.
+fn run_ironing(name: &str) -> (tempfile::TempDir, Vec<(&'static str, History, Results)>) {
+    let dir = tempdir();
+    for d in ["meshes", "pipelines"] {
+        std::fs::create_dir_all(dir.path().join(d)).unwrap();
+    }
+    std::fs::copy(repo().join("meshes/ironing3d.msh"), dir.path().join("meshes/ironing3d.msh")).unwrap();
+    std::fs::copy(repo().join(format!("pipelines/{name}.yaml")), dir.path().join(format!("pipelines/{name}.yaml"))).unwrap();
+    let o = run("sc-pipeline", &["-q", &format!("pipelines/{name}.yaml")], dir.path());
+    assert!(o.status.success(), "{name}: {}", stderr(&o));
+    let out = dir.path().join("pipelines/out");
+    let png = std::fs::read(out.join(format!("{name}_forces.png"))).unwrap();
+    assert!(png.starts_with(b"\x89PNG") && png.len() > 20_000, "{name}: the plot stage's PNG");
+    let masters = ["facet", "b3", "b4"]
+        .into_iter()
+        .map(|m| {
+            let h = history(&out.join(format!("{name}-{m}.forces.csv")));
+            let r = Results::read(&out.join(format!("{name}-{m}.scres"))).unwrap();
+            assert_eq!(r.status, RunStatus::Completed, "{name}-{m}");
+            (m, h, r)
+        })
+        .collect();
+    (dir, masters)
+}
+
+fn newton_and_cutbacks(r: &Results) -> (usize, u32) {
+    (r.increments.iter().map(|i| i.info.iterations.len() - 1).sum(), r.increments.iter().map(|i| i.info.cutbacks).sum())
+}
+
+/// Pins (2026-11-23): (master, V oscillation RMS, H ripple RMS / V, Newton corrections,
+/// cutbacks). Oscillation figures ±30 %: they are differences of nearly equal forces
+/// (1e-4–1e-3 of V) and move with the Newton tolerance and the platform's rounding,
+/// but a change of the master's geometry or of the contact element moves them by
+/// factors. Corrections: measured + 25 % (+2); cutbacks: measured + 2.
+struct Pin {
+    master: &'static str,
+    v_rms: f64,
+    h_rms: f64,
+    newton: usize,
+    cutbacks: u32,
+}
+
+fn check(name: &str, masters: &[(&'static str, History, Results)], pins: &[Pin]) {
+    for ((m, h, r), pin) in masters.iter().zip(pins) {
+        assert_eq!(*m, pin.master);
+        let v = oscillation(&h.s, &h.v, ELEMENT, STEADY.0, STEADY.1).unwrap();
+        let hr = h_ripple(h);
+        let (its, cut) = newton_and_cutbacks(r);
+        eprintln!("{name}-{m}: V mean {:.5}, V oscillation {:.3e} (p2p {:.3e}), H ripple / V {hr:.3e}, {its} Newton corrections, {cut} cutbacks", v.mean, v.rms, v.peak_to_peak);
+        assert!((v.rms / pin.v_rms - 1.0).abs() < 0.3, "{name}-{m}: V oscillation {:.3e} (pinned {:.3e})", v.rms, pin.v_rms);
+        assert!((hr / pin.h_rms - 1.0).abs() < 0.3, "{name}-{m}: H ripple {hr:.3e} (pinned {:.3e})", pin.h_rms);
+        assert!(its as f64 <= 1.25 * pin.newton as f64 + 2.0, "{name}-{m}: {its} Newton corrections (pinned {})", pin.newton);
+        assert!(cut <= pin.cutbacks + 2, "{name}-{m}: {cut} cutbacks (pinned {})", pin.cutbacks);
+    }
+}
+
+#[test]
+fn ironing3d_frictionless_facet_against_bspline() {
+    let (_dir, masters) = run_ironing("ironing3d_frictionless");
+    check("frictionless", &masters, &PINS_FRICTIONLESS);
+    let ripple: Vec<f64> = masters.iter().map(|(_, h, _)| h_ripple(h)).collect();
+    // the cubic B-spline master: H ripple at most 1/5 of the facets' (the target)
+    assert!(ripple[2] <= 0.2 * ripple[0], "B-spline [4, 4] H ripple {:.3e} vs facet {:.3e}", ripple[2], ripple[0]);
+    for (m, h, _) in &masters {
+        // frictionless steady sliding: H ≈ 0 (measured |mean H| / V ≤ 4e-4, facet)
+        let hm = oscillation(&h.s, &h.h, ELEMENT, STEADY.0, STEADY.1).unwrap().mean;
+        let vm = oscillation(&h.s, &h.v, ELEMENT, STEADY.0, STEADY.1).unwrap().mean;
+        assert!(hm.abs() < 1e-3 * vm, "{m}: mean H / V = {}", hm / vm);
+    }
+}
+
+#[test]
+fn ironing3d_coulomb_facet_against_bspline() {
+    let (_dir, masters) = run_ironing("ironing3d");
+    check("mu 0.3", &masters, &PINS_COULOMB);
+    // the cubic B-spline master: V and H ripple at most 1/5 of the facets' (the
+    // issue's target; measured 0.17 and 0.07 — the quadratic one gives 0.47 and 0.29)
+    let v_rms: Vec<f64> = masters.iter().map(|(_, h, _)| oscillation(&h.s, &h.v, ELEMENT, STEADY.0, STEADY.1).unwrap().rms).collect();
+    let ripple: Vec<f64> = masters.iter().map(|(_, h, _)| h_ripple(h)).collect();
+    assert!(v_rms[2] <= 0.2 * v_rms[0], "B-spline [4, 4] V oscillation {:.3e} vs facet {:.3e}", v_rms[2], v_rms[0]);
+    assert!(ripple[2] <= 0.2 * ripple[0], "B-spline [4, 4] H ripple {:.3e} vs facet {:.3e}", ripple[2], ripple[0]);
+    for (m, h, _) in &masters {
+        // Steady sliding, every active node slides: H/V → μ = 0.3; measured 0.2946
+        // (B4) – 0.2969 (facet): the die's shell flexes, the normal force tilts, and
+        // the slab ahead of the die is lifted: within 0.01 of μ.
+        let hm = oscillation(&h.s, &h.h, ELEMENT, STEADY.0, STEADY.1).unwrap().mean;
+        let vm = oscillation(&h.s, &h.v, ELEMENT, STEADY.0, STEADY.1).unwrap().mean;
+        assert!((hm / vm - 0.3).abs() < 0.01, "{m}: H/V = {}", hm / vm);
+        // Σ|T| = μ Σ|N| exactly (return mapping); |ΣT| / |ΣN| differs from μ by the
+        // spread of the nodes' normals and sliding directions: measured 0.2992
+        // (B4) – 0.3003 (facet, whose normals jump): within 1 % of μ.
+        for (s, r) in h.s.iter().zip(&h.t_over_n) {
+            if (STEADY.0..=STEADY.1).contains(s) {
+                assert!((r - 0.3).abs() < 0.003, "{m}: tangential / normal contact force = {r} at travel {s}");
+            }
+        }
+    }
+}
+
+const PINS_FRICTIONLESS: [Pin; 3] = [
+    Pin { master: "facet", v_rms: 6.86e-4, h_rms: 3.14e-3, newton: 577, cutbacks: 0 },
+    Pin { master: "b3", v_rms: 7.93e-4, h_rms: 1.11e-3, newton: 350, cutbacks: 0 },
+    Pin { master: "b4", v_rms: 2.15e-4, h_rms: 2.18e-4, newton: 350, cutbacks: 0 },
+];
+
+const PINS_COULOMB: [Pin; 3] = [
+    Pin { master: "facet", v_rms: 1.68e-3, h_rms: 3.98e-3, newton: 510, cutbacks: 0 },
+    Pin { master: "b3", v_rms: 7.93e-4, h_rms: 1.15e-3, newton: 406, cutbacks: 0 },
+    Pin { master: "b4", v_rms: 2.81e-4, h_rms: 2.84e-4, newton: 412, cutbacks: 0 },
+];
