@@ -63,7 +63,14 @@ pub struct Outputs<'a> {
 pub fn forces_csv(results: &Results) -> String {
     let mut out = String::from("increment,load_factor");
     let first = results.increments.first();
-    let sets: Vec<String> = first.map(|i| i.info.reactions.iter().map(|r| r.set.clone()).collect()).unwrap_or_default();
+    // one column triple per set (a set constrained by two entries, e.g. a press and a
+    // slide, is listed once)
+    let mut sets: Vec<String> = Vec::new();
+    for r in first.map(|i| &i.info.reactions[..]).unwrap_or_default() {
+        if !sets.contains(&r.set) {
+            sets.push(r.set.clone());
+        }
+    }
     for s in &sets {
         out.push_str(&format!(",reaction:{s}:x,reaction:{s}:y,reaction:{s}:z"));
     }

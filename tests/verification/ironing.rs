@@ -15,14 +15,15 @@ use splinecontact::post::oscillation::oscillation;
 
 use crate::common::{repo, run, stderr, tempdir};
 
-/// The die slides 4 over t ∈ [1, 2]; the slab's element length along x is 9 / 20.
+/// The die slides 4 over t ∈ [0.2, 1.2]; the slab's element length along x is 9 / 20.
 const TRAVEL: f64 = 4.0;
+const SLIDE_START: f64 = 0.2;
 const ELEMENT: f64 = 0.45;
 /// Steady sliding: the travel [1, 3] (the contact zone, ~1.5 wide, is clear of the
 /// slab's ends and of the start of sliding).
 const STEADY: (f64, f64) = (1.0, 3.0);
 
-/// One master's histories: travel s = 4 (t − 1), V, H, tangential / normal contact force.
+/// One master's histories: travel s = 4 (t − 0.2), V, H, tangential / normal contact force.
 struct History {
     s: Vec<f64>,
     v: Vec<f64>,
@@ -36,8 +37,8 @@ fn history(path: &Path) -> History {
     let (lf, rz, rx) = (col("load_factor"), col("reaction:die_top:z"), col("reaction:die_top:x"));
     let (c, tg) = ([0, 1, 2].map(|k| col(&format!("contact:contact:{}", ["x", "y", "z"][k]))), [0, 1, 2].map(|k| col(&format!("tangential:contact:{}", ["x", "y", "z"][k]))));
     let mut h = History { s: vec![], v: vec![], h: vec![], t_over_n: vec![] };
-    for r in t.rows.iter().filter(|r| r[lf] >= 1.0 - 1e-9) {
-        h.s.push(TRAVEL * (r[lf] - 1.0));
+    for r in t.rows.iter().filter(|r| r[lf] >= SLIDE_START - 1e-9) {
+        h.s.push(TRAVEL * (r[lf] - SLIDE_START));
         h.v.push(-r[rz]);
         h.h.push(r[rx]);
         let tv = tg.map(|k| r[k]);
@@ -133,14 +134,14 @@ fn ironing3d_coulomb_facet_against_bspline() {
     let (_dir, masters) = run_ironing("ironing3d");
     check("mu 0.3", &masters, &PINS_COULOMB);
     // the cubic B-spline master: V and H ripple at most 1/5 of the facets' (the
-    // issue's target; measured 0.17 and 0.07 — the quadratic one gives 0.47 and 0.29)
+    // issue's target; measured 0.17 and 0.08 — the quadratic one gives 0.47 and 0.32)
     let v_rms: Vec<f64> = masters.iter().map(|(_, h, _)| oscillation(&h.s, &h.v, ELEMENT, STEADY.0, STEADY.1).unwrap().rms).collect();
     let ripple: Vec<f64> = masters.iter().map(|(_, h, _)| h_ripple(h)).collect();
     assert!(v_rms[2] <= 0.2 * v_rms[0], "B-spline [4, 4] V oscillation {:.3e} vs facet {:.3e}", v_rms[2], v_rms[0]);
     assert!(ripple[2] <= 0.2 * ripple[0], "B-spline [4, 4] H ripple {:.3e} vs facet {:.3e}", ripple[2], ripple[0]);
     for (m, h, _) in &masters {
         // Steady sliding, every active node slides: H/V → μ = 0.3; measured 0.2946
-        // (B4) – 0.2969 (facet): the die's shell flexes, the normal force tilts, and
+        // (B4) – 0.2972 (facet): the die's shell flexes, the normal force tilts, and
         // the slab ahead of the die is lifted: within 0.01 of μ.
         let hm = oscillation(&h.s, &h.h, ELEMENT, STEADY.0, STEADY.1).unwrap().mean;
         let vm = oscillation(&h.s, &h.v, ELEMENT, STEADY.0, STEADY.1).unwrap().mean;
@@ -157,13 +158,13 @@ fn ironing3d_coulomb_facet_against_bspline() {
 }
 
 const PINS_FRICTIONLESS: [Pin; 3] = [
-    Pin { master: "facet", v_rms: 6.86e-4, h_rms: 3.14e-3, newton: 577, cutbacks: 0 },
-    Pin { master: "b3", v_rms: 7.93e-4, h_rms: 1.11e-3, newton: 350, cutbacks: 0 },
-    Pin { master: "b4", v_rms: 2.15e-4, h_rms: 2.18e-4, newton: 350, cutbacks: 0 },
+    Pin { master: "facet", v_rms: 6.86e-4, h_rms: 3.14e-3, newton: 389, cutbacks: 0 },
+    Pin { master: "b3", v_rms: 7.93e-4, h_rms: 1.11e-3, newton: 251, cutbacks: 0 },
+    Pin { master: "b4", v_rms: 2.15e-4, h_rms: 2.18e-4, newton: 251, cutbacks: 0 },
 ];
 
 const PINS_COULOMB: [Pin; 3] = [
-    Pin { master: "facet", v_rms: 1.68e-3, h_rms: 3.98e-3, newton: 510, cutbacks: 0 },
-    Pin { master: "b3", v_rms: 7.93e-4, h_rms: 1.15e-3, newton: 406, cutbacks: 0 },
-    Pin { master: "b4", v_rms: 2.81e-4, h_rms: 2.84e-4, newton: 412, cutbacks: 0 },
+    Pin { master: "facet", v_rms: 1.68e-3, h_rms: 3.61e-3, newton: 393, cutbacks: 0 },
+    Pin { master: "b3", v_rms: 7.93e-4, h_rms: 1.15e-3, newton: 300, cutbacks: 0 },
+    Pin { master: "b4", v_rms: 2.81e-4, h_rms: 2.84e-4, newton: 300, cutbacks: 0 },
 ];
