@@ -3,6 +3,13 @@
 //! residual R(u) = f_int(u) − f_ext(λ) and the tangent K_ff, solve K_ff Δu = −R_f,
 //! update, until the residual (relative to the external or reaction force) and the
 //! energy norm of the correction are both below tolerance.
+//!
+//! With contact the residual is only piecewise smooth, so three safeguards apply
+//! (docs/theory.md, "Robustness"): a correction that inverts an element, or (from the
+//! second on) raises ‖R_f‖, is halved; after `search_updates` iterations, or at a
+//! 2-cycle of the contact configuration, the pairs hold their master facets and
+//! stick/slip branches ([`PairSolver::freeze`]) until the solve converges; a 2-cycle
+//! that persists fails the increment, naming the nodes.
 
 use std::time::Instant;
 
@@ -304,24 +311,21 @@ impl<'p> Newton<'p> {
                 let t = Instant::now();
                 let assembled = self.assemble(u, lambda);
                 seconds_assembly += t.elapsed().as_secs_f64();
-                let backtrack = match assembled {
+                match assembled {
                     Ok(()) => {
                         dofs.gather_free(&self.residual, &mut self.rhs);
                         let r_norm = self.rhs.iter().map(|v| v * v).sum::<f64>().sqrt();
                         // Line search: the full correction raised the residual; take a
                         // shorter one (α = ½, ¼, …), or the last tried if none lowers it.
-                        if line_search && r_norm > last_r_norm && halvings < self.settings.max_step_halvings {
-                            self.line_search_steps += 1;
-                            true
-                        } else {
+                        if !(line_search && r_norm > last_r_norm && halvings < self.settings.max_step_halvings) {
                             break r_norm;
                         }
+                        self.line_search_steps += 1;
                     }
                     // Step control: the correction inverted an element; go back half of
                     // it and try again before giving the increment up.
                     Err(AssemblyFailure::Hex(..)) if iteration > 0 && halvings < self.settings.max_step_halvings => {
                         self.step_halvings += 1;
-                        true
                     }
                     Err(f) => {
                         self.release_contact();
@@ -333,14 +337,12 @@ impl<'p> Newton<'p> {
                             }
                         });
                     }
-                };
-                if backtrack {
-                    // u ← u − ½Δu (Δu, kept in r_free, halves)
-                    self.r_free.iter_mut().for_each(|d| *d *= -0.5);
-                    dofs.add_free(&self.r_free, u);
-                    self.r_free.iter_mut().for_each(|d| *d = -*d);
-                    halvings += 1;
                 }
+                // back half of the correction: u ← u − ½Δu (Δu, kept in r_free, halves)
+                self.r_free.iter_mut().for_each(|d| *d *= -0.5);
+                dofs.add_free(&self.r_free, u);
+                self.r_free.iter_mut().for_each(|d| *d = -*d);
+                halvings += 1;
             };
             last_r_norm = r_norm;
             let reaction_norm = (0..self.residual.len()).filter(|&d| dofs.is_constrained(d)).map(|d| self.residual[d].powi(2)).sum::<f64>().sqrt();
