@@ -37,6 +37,10 @@ from pathlib import Path
 import meshio
 import numpy as np
 
+# the ccx face table, the (f20.0) float field, the number pattern and the .cvg
+# reader are the general deck generator's (this script is its Parisch special case)
+from deck import HEX_FACES, NUM, fmt, parse_cvg
+
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent.parent
 MESH = ROOT / "meshes" / "parisch.msh"
@@ -54,26 +58,6 @@ DEFAULT_TENSION = 1.0e-6
 # 1e-8 is about as tight as it converges (1e-10 never converges).
 DEFAULT_RAN = 1.0e-8
 SWEEP_SLOPES = [1e5, 1e6, 1e7, 1e8, 1e9]
-
-# ccx C3D8 faces (ccx source, array ifaceq: 1-based local nodes, ordered so the
-# normal points out of the element).  gmsh hex8 node order == ccx C3D8 order.
-HEX_FACES = {
-    1: (4, 3, 2, 1),
-    2: (5, 6, 7, 8),
-    3: (1, 2, 6, 5),
-    4: (2, 3, 7, 6),
-    5: (3, 4, 8, 7),
-    6: (4, 1, 5, 8),
-}
-
-
-def fmt(x):
-    """A float field ccx reads with (f20.0): at most 20 characters."""
-    s = repr(float(x))
-    if len(s) > 20:
-        s = "%.13e" % x
-    assert len(s) <= 20, s
-    return s
 
 
 def neo_hooke(E, nu):
@@ -220,7 +204,6 @@ def write_deck(model, path, slope, force, tension, ran=DEFAULT_RAN):
 
 
 # ---------------------------------------------------------------- .dat parsing
-NUM = r"[-+]?\d+\.?\d*(?:[EeDd][-+]?\d+)?"
 
 
 def parse_dat(text):
@@ -259,16 +242,6 @@ def parse_sta(text):
             incs += 1
             iters.append(int(t[3]))
     return incs, iters
-
-
-def parse_cvg(text):
-    """Rows of the .cvg file: step inc att iter contel resid corr_disp ..."""
-    rows = []
-    for line in text.splitlines():
-        t = line.split()
-        if len(t) >= 8 and all(re.fullmatch(NUM, x) for x in t[:8]):
-            rows.append([float(x) for x in t[:8]])
-    return rows
 
 
 def slave_areas(model, disp=None):
