@@ -289,11 +289,12 @@ impl PairSolver {
     /// update" limit of FEBio and others). B-spline masters have no elements to hold.
     ///
     /// With friction the return mapping's branch of every pressed slave (stick or
-    /// slip, eq. 4.8 at the last search) is held as well: a node at the slip
-    /// threshold switching branch from one iterate to the next leaves a kink in the
-    /// residual that stalls Newton at ~1e-7 (measured on the 3D ironing). The state
-    /// converged with held branches violates the slip criterion of such a node by
-    /// no more than the last iterates moved it.
+    /// slip, eq. 4.8 at the last search) is held as well, so a node at the slip
+    /// threshold cannot switch branch from one iterate to the next (a kink in the
+    /// residual). The state converged with held branches violates the slip
+    /// criterion of such a node by no more than the last iterates moved it. (It did
+    /// not remove the relative-residual floor of ~3e-7 measured on the 3D ironing
+    /// pressed 1.4 with friction: that stall has another cause, not yet found.)
     pub fn freeze(&mut self) {
         self.frozen = true;
         if self.settings.frictional() {

@@ -98,13 +98,11 @@ pub struct Newton<'p> {
     symmetry: Symmetry,
     /// Newton corrections halved because they inverted an element (all solves).
     pub step_halvings: u32,
-    /// Corrections halved by the late iterations' line search (all solves).
+    /// Corrections halved by the line search (all solves).
     pub line_search_steps: u32,
     /// The iteration at which the current solve held the contact search's master
     /// elements, and why ([`PairSolver::freeze`]); `None` while they may change.
     pub frozen_at: Option<(u32, &'static str)>,
-    /// Solves that held their master elements (all solves).
-    pub frozen_solves: u32,
 }
 
 /// A converged increment's iteration history.
@@ -156,7 +154,6 @@ impl<'p> Newton<'p> {
             step_halvings: 0,
             line_search_steps: 0,
             frozen_at: None,
-            frozen_solves: 0,
         })
     }
 
@@ -191,13 +188,14 @@ impl<'p> Newton<'p> {
     }
 
     /// Hold the master elements of every pair's search for the rest of this solve.
-    fn freeze_contact(&mut self, iteration: u32, why: &'static str) {
+    /// Whether it did so now (not when already held or when no pair can hold anything).
+    fn freeze_contact(&mut self, iteration: u32, why: &'static str) -> bool {
         if self.frozen_at.is_some() || !self.contact.iter().any(|c| c.can_freeze()) {
-            return;
+            return false;
         }
         self.contact.iter_mut().for_each(PairSolver::freeze);
         self.frozen_at = Some((iteration, why));
-        self.frozen_solves += 1;
+        true
     }
 
     /// Let the searches choose master elements again (at the start and end of a
@@ -411,9 +409,8 @@ impl<'p> Newton<'p> {
                 }
                 let two_cycle = iteration >= 2 && configs[0] == configs[2] && configs[0] != configs[1];
                 cycling = if two_cycle { cycling + 1 } else { 0 };
-                if cycling >= 3 && self.settings.search_updates > 0 && self.frozen_at.is_none() && self.contact.iter().any(|c| c.can_freeze()) {
-                    // first remedy: hold the master elements and let Newton finish
-                    self.freeze_contact(iteration, "the contact configuration cycles");
+                // first remedy: hold the master elements and let Newton finish
+                if cycling >= 3 && self.settings.search_updates > 0 && self.freeze_contact(iteration, "the contact configuration cycles") {
                     cycling = 0;
                 } else if cycling >= 3 {
                     let tags = &p.node_tags;

@@ -174,11 +174,16 @@ impl FacetProjector {
 
     /// Bounded Newton on one cell.
     fn in_cell(&self, p: &Vec3, cell: [usize; 2]) -> NewtonResult {
+        let (lo, hi) = self.facets.cell_bounds(cell);
+        self.newton_on_map(p, cell, lo, hi)
+    }
+
+    /// Newton on `cell`'s bilinear map over the box ξ ∈ [lo, hi] (which may reach
+    /// beyond the cell), started at its middle.
+    fn newton_on_map(&self, p: &Vec3, cell: [usize; 2], lo: [f64; 2], hi: [f64; 2]) -> NewtonResult {
         let o = &self.options;
-        let bounds = self.facets.cell_bounds(cell);
-        let width = [bounds.1[0] - bounds.0[0], bounds.1[1] - bounds.0[1]];
-        let mid = [0.5 * (bounds.0[0] + bounds.1[0]), 0.5 * (bounds.0[1] + bounds.1[1])];
-        newton(|xi| self.facets.jet_in_cell(&self.x, cell, xi), p, mid, bounds, width, o.tol * self.scale, o.max_iterations)
+        let mid = [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])];
+        newton(|xi| self.facets.jet_in_cell(&self.x, cell, xi), p, mid, (lo, hi), [hi[0] - lo[0], hi[1] - lo[1]], o.tol * self.scale, o.max_iterations)
     }
 
     /// Closest point of the facet set to `p` and the cell it lies on, with
@@ -259,9 +264,7 @@ impl FacetProjector {
             lo[al] = (lo[al] - width[al]).max(0.0);
             hi[al] = (hi[al] + width[al]).min(1.0);
         }
-        let o = &self.options;
-        let mid = [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])];
-        newton(|xi| self.facets.jet_in_cell(&self.x, cell, xi), p, mid, (lo, hi), [hi[0] - lo[0], hi[1] - lo[1]], o.tol * self.scale, o.max_iterations)
+        self.newton_on_map(p, cell, lo, hi)
     }
 
     /// Closest point on `cell`'s bilinear map extended beyond the patch edge by up to
@@ -277,7 +280,7 @@ impl FacetProjector {
                 hi[al] += margin[al];
             }
         }
-        self.project_on_map(p, cell, lo, hi)
+        finish(p, &self.newton_on_map(p, cell, lo, hi), self.options.outside_tol * self.scale)
     }
 
     /// Closest point on `cell`'s bilinear map continued over one cell width beyond
@@ -298,14 +301,6 @@ impl FacetProjector {
         } else {
             self.project_keeping(p, Some(cell))
         }
-    }
-
-    /// Bounded Newton on `cell`'s bilinear map over ξ ∈ [lo, hi].
-    fn project_on_map(&self, p: &Vec3, cell: [usize; 2], lo: [f64; 2], hi: [f64; 2]) -> Projection {
-        let o = &self.options;
-        let mid = [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])];
-        let res = newton(|xi| self.facets.jet_in_cell(&self.x, cell, xi), p, mid, (lo, hi), [hi[0] - lo[0], hi[1] - lo[1]], o.tol * self.scale, o.max_iterations);
-        finish(p, &res, o.outside_tol * self.scale)
     }
 
     /// Evaluation at ξ on a given cell (the one [`Self::project_keeping`] returned).
