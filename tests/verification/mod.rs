@@ -5,3 +5,4 @@ mod benchmarks;
 mod friction;
 mod paper_examples;
 mod ironing;
+mod shallow_ironing;

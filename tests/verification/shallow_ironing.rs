@@ -1,0 +1,175 @@
+//! Large sliding: the shallow ironing (pipelines/shallow_ironing.yaml, μ = 0.3, and
+//! shallow_ironing_frictionless.yaml; mesh meshes/shallow_ironing.geo) with the cubic
+//! B-spline master (orders [2, 4], the sliding direction cubic), on the published load
+//! path up to t = 1.5: pressed 1 over t ∈ [0, 1], then slid 5 of the published 10 (the
+//! force check of benchmarks.md is at t = 1.5). The test pipeline is the shipped one
+//! with the [2, 4] chain's stages only, its setup unchanged but `increments` ending at
+//! t = 1.5 with the same step (150 of the 200 increments). Pinned: V(1.5) inside the
+//! published band and to the measured value, H/V (frictionless: H ≈ 0), the
+//! tangential / normal contact force, the V oscillation over the sliding, and the
+//! Newton corrections and cutbacks. docs/validation.md, "Shallow ironing", has the
+//! table these numbers come from. (The facet master does not reach the sliding phase
+//! on this benchmark: docs/validation.md says what was tried.)
+
+use serde_yaml::{Mapping, Value};
+
+use splinecontact::format::csv::Table;
+use splinecontact::format::scres::{Results, RunStatus};
+use splinecontact::post::oscillation::oscillation;
+
+use crate::common::{repo, run, stderr, tempdir};
+
+/// The indenter slides 10 over t ∈ [1, 2]; the foundation's element length along x is 12 / 60.
+const SLIDE: f64 = 10.0;
+const ELEMENT: f64 = 0.2;
+/// Steady sliding in the shortened run: travel [2, 5] (t ∈ [1.2, 1.5]; the force
+/// history settles within 1 mm of the start of sliding, docs/validation.md).
+const STEADY: (f64, f64) = (2.0, 5.0);
+
+/// The shipped pipeline `name` reduced to its B-spline [2, 4] chain (import, tag,
+/// solve), ending at t = 1.5.
+fn derived_pipeline(name: &str) -> String {
+    let path = repo().join(format!("pipelines/{name}.yaml"));
+    let text = std::fs::read_to_string(&path).unwrap();
+    // serde_yaml resolves the `&ironing_setup` anchor and its aliases into copies
+    let mut doc: Value = serde_yaml::from_str(&text).unwrap();
+    let stages = doc.get_mut("stages").and_then(Value::as_sequence_mut).unwrap();
+    stages.retain(|stage| {
+        let (kind, body) = stage.as_mapping().unwrap().iter().next().unwrap();
+        let io = |k: &str| body.get(k).and_then(Value::as_str).unwrap_or("").to_string();
+        match kind.as_str().unwrap() {
+            "import" => true,
+            "tag" | "solve" => io("output").contains("-b4."),
+            _ => false, // export, plot
+        }
+    });
+    let mut n_solves = 0;
+    for stage in stages.iter_mut() {
+        if let Some(setup) = stage.get_mut("solve").and_then(|s| s.get_mut("setup")) {
+            let inc = setup.get_mut("increments").and_then(Value::as_mapping_mut).unwrap();
+            // the published step, 0.01 of t (200 increments over [0, 2])
+            assert_eq!(inc.get("count").and_then(Value::as_u64), Some(200), "{name}: increments");
+            let mut m = Mapping::new();
+            m.insert("count".into(), 150.into());
+            m.insert("end".into(), 1.5.into());
+            m.insert("max_cutbacks".into(), inc.get("max_cutbacks").cloned().unwrap_or(6.into()));
+            *inc = m;
+            n_solves += 1;
+        }
+    }
+    assert_eq!(n_solves, 1, "{name}: one B-spline [2, 4] solve stage");
+    serde_yaml::to_string(&doc).unwrap()
+}
+
+struct Run {
+    /// Travel 10 (t − 1) and the reaction on the indenter top (V = −R_y, H = R_x).
+    s: Vec<f64>,
+    v: Vec<f64>,
+    h: Vec<f64>,
+    /// |Σ tangential| / |Σ normal| contact force.
+    t_over_n: Vec<f64>,
+    results: Results,
+}
+
+fn solve(name: &str) -> Run {
+    let dir = tempdir();
+    for d in ["meshes", "pipelines"] {
+        std::fs::create_dir_all(dir.path().join(d)).unwrap();
+    }
+    std::fs::copy(repo().join("meshes/shallow_ironing.msh"), dir.path().join("meshes/shallow_ironing.msh")).unwrap();
+    std::fs::write(dir.path().join("pipelines/test.yaml"), derived_pipeline(name)).unwrap();
+    let o = run("sc-pipeline", &["-q", "pipelines/test.yaml"], dir.path());
+    assert!(o.status.success(), "{name}: {}", stderr(&o));
+    let out = dir.path().join("pipelines/out");
+    let t = Table::read(&out.join(format!("{name}-b4.forces.csv"))).unwrap();
+    let col = |n: &str| t.column(n).unwrap_or_else(|| panic!("{name}: no column {n}"));
+    let (lf, ry, rx) = (col("load_factor"), col("reaction:indenter_top:y"), col("reaction:indenter_top:x"));
+    let c = [0, 1, 2].map(|k| col(&format!("contact:contact:{}", ["x", "y", "z"][k])));
+    let tg = [0, 1, 2].map(|k| col(&format!("tangential:contact:{}", ["x", "y", "z"][k])));
+    let norm = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    let mut r = Run { s: vec![], v: vec![], h: vec![], t_over_n: vec![], results: Results::read(&out.join(format!("{name}-b4.scres"))).unwrap() };
+    for row in t.rows.iter().filter(|row| row[lf] >= 1.0 - 1e-9) {
+        r.s.push(SLIDE * (row[lf] - 1.0));
+        r.v.push(-row[ry]);
+        r.h.push(row[rx]);
+        let tv = tg.map(|k| row[k]);
+        r.t_over_n.push(norm(tv) / norm([0, 1, 2].map(|k| row[c[k]] - tv[k])));
+    }
+    assert_eq!(r.results.status, RunStatus::Completed, "{name}");
+    assert!((r.s.last().unwrap() - 5.0).abs() < 1e-9, "{name}: the run ends at t = 1.5");
+    r
+}
+
+/// V and H at the end (t = 1.5), the V oscillation, Newton corrections and cutbacks.
+fn summary(name: &str, r: &Run) -> (f64, f64, f64, usize, u32) {
+    let (v, h) = (*r.v.last().unwrap(), *r.h.last().unwrap());
+    let osc = oscillation(&r.s, &r.v, ELEMENT, STEADY.0, STEADY.1).unwrap();
+    let its = r.results.increments.iter().map(|i| i.info.iterations.len() - 1).sum();
+    let cut = r.results.increments.iter().map(|i| i.info.cutbacks).sum();
+    eprintln!("{name}-b4: V(1.5) {v:.2}, H(1.5) {h:.3}, H/V {:.4}, V oscillation {:.3e} (p2p {:.3e}), {its} Newton corrections, {cut} cutbacks", h / v, osc.rms, osc.peak_to_peak);
+    (v, h, osc.rms, its, cut)
+}
+
+/// Published at t = 1.5 (six codes, benchmarks.md): V between 337 and 421 N/mm.
+fn check_published_band(name: &str, v: f64) {
+    assert!((337.0..=421.0).contains(&v), "{name}: V(1.5) = {v} outside the published 337–421");
+}
+
+#[test]
+fn shallow_ironing_frictionless_bspline() {
+    let name = "shallow_ironing_frictionless";
+    let r = solve(name);
+    let (v, h, v_rms, its, cut) = summary(name, &r);
+    check_published_band(name, v);
+    // pinned (2026-11-23, the full pipeline gives the same to 0.1 N/mm): V(1.5) = 397.6.
+    // 1 %: the mesh, load path and tolerances are fixed; a change of the master's
+    // geometry or of the contact element moves it by several N/mm.
+    assert!((v / 397.6 - 1.0).abs() < 0.01, "{name}: V(1.5) = {v}");
+    // frictionless: H only from the normal force's tilt, which cancels between the
+    // indenter's flanks in steady sliding (measured 1.1e-4 of V at t = 1.5)
+    assert!(h.abs() < 1e-3 * v, "{name}: H/V = {}", h / v);
+    check_pins(name, v_rms, its, cut, &PIN_FRICTIONLESS);
+}
+
+#[test]
+fn shallow_ironing_coulomb_bspline() {
+    let name = "shallow_ironing";
+    let r = solve(name);
+    let (v, h, v_rms, its, cut) = summary(name, &r);
+    check_published_band(name, v);
+    // pinned V(1.5) = 399.9 (1 %, as above); the published H/V at t = 1.5 is 0.30–0.53
+    assert!((v / 399.9 - 1.0).abs() < 0.01, "{name}: V(1.5) = {v}");
+    assert!((0.30..=0.53).contains(&(h / v)), "{name}: H/V(1.5) = {} outside the published 0.30–0.53", h / v);
+    // Steady sliding, every pressed node slides: Σ|T| = μ Σ|N| exactly (return
+    // mapping); the vector sums differ from μ by the spread of the normals along the
+    // arc: measured 0.301–0.302, within 0.005 of μ. H/V adds the tilt of the normal
+    // force on the indenter (the foundation piles up ahead of it): measured 0.306–0.320
+    // over the travel [2, 5], within [0.3, 0.33].
+    for (i, s) in r.s.iter().enumerate() {
+        if (STEADY.0..=STEADY.1).contains(s) {
+            assert!((r.t_over_n[i] - 0.3).abs() < 0.005, "{name}: tangential / normal contact force {} at travel {s}", r.t_over_n[i]);
+            let hv = r.h[i] / r.v[i];
+            assert!((0.30..=0.33).contains(&hv), "{name}: H/V = {hv} at travel {s}");
+        }
+    }
+    check_pins(name, v_rms, its, cut, &PIN_COULOMB);
+}
+
+/// Pins (2026-11-23): V oscillation RMS over the travel [2, 5] ±30 % (a difference of
+/// nearly equal forces, 1e-4 of V, that moves with the Newton tolerance and the
+/// platform's rounding, but by factors with the master's smoothness); Newton
+/// corrections + 25 % (+2); cutbacks + 2.
+struct Pin {
+    v_rms: f64,
+    newton: usize,
+    cutbacks: u32,
+}
+
+fn check_pins(name: &str, v_rms: f64, its: usize, cut: u32, pin: &Pin) {
+    assert!((v_rms / pin.v_rms - 1.0).abs() < 0.3, "{name}: V oscillation {v_rms:.3e} (pinned {:.3e})", pin.v_rms);
+    assert!(its as f64 <= 1.25 * pin.newton as f64 + 2.0, "{name}: {its} Newton corrections (pinned {})", pin.newton);
+    assert!(cut <= pin.cutbacks + 2, "{name}: {cut} cutbacks (pinned {})", pin.cutbacks);
+}
+
+const PIN_FRICTIONLESS: Pin = Pin { v_rms: 1.50e-4, newton: 1143, cutbacks: 0 };
+const PIN_COULOMB: Pin = Pin { v_rms: 1.07e-4, newton: 1145, cutbacks: 0 };
