@@ -7,12 +7,10 @@
 //! iterations and cutbacks of every master. docs/validation.md, "3D ironing", has
 //! the table these numbers come from.
 
-use std::path::Path;
-
-use splinecontact::format::csv::Table;
 use splinecontact::format::scres::{Results, RunStatus};
 use splinecontact::post::oscillation::oscillation;
 
+use super::sliding::{history, newton_and_cutbacks, History};
 use crate::common::{repo, run, stderr, tempdir};
 
 /// The die slides 4 over t ∈ [0.2, 1.2]; the slab's element length along x is 9 / 20.
@@ -22,32 +20,6 @@ const ELEMENT: f64 = 0.45;
 /// Steady sliding: the travel [1, 3] (the contact zone, ~1.5 wide, is clear of the
 /// slab's ends and of the start of sliding).
 const STEADY: (f64, f64) = (1.0, 3.0);
-
-/// One master's histories: travel s = 4 (t − 0.2), V, H, tangential / normal contact force.
-struct History {
-    s: Vec<f64>,
-    v: Vec<f64>,
-    h: Vec<f64>,
-    t_over_n: Vec<f64>,
-}
-
-fn history(path: &Path) -> History {
-    let t = Table::read(path).unwrap();
-    let col = |n: &str| t.column(n).unwrap_or_else(|| panic!("{}: no column {n}", path.display()));
-    let (lf, rz, rx) = (col("load_factor"), col("reaction:die_top:z"), col("reaction:die_top:x"));
-    let (c, tg) = ([0, 1, 2].map(|k| col(&format!("contact:contact:{}", ["x", "y", "z"][k]))), [0, 1, 2].map(|k| col(&format!("tangential:contact:{}", ["x", "y", "z"][k]))));
-    let mut h = History { s: vec![], v: vec![], h: vec![], t_over_n: vec![] };
-    for r in t.rows.iter().filter(|r| r[lf] >= SLIDE_START - 1e-9) {
-        h.s.push(TRAVEL * (r[lf] - SLIDE_START));
-        h.v.push(-r[rz]);
-        h.h.push(r[rx]);
-        let tv = tg.map(|k| r[k]);
-        let nv = [0, 1, 2].map(|k| r[c[k]] - tv[k]);
-        let norm = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-        h.t_over_n.push(norm(tv) / norm(nv));
-    }
-    h
-}
 
 /// RMS of the horizontal force about its one-element moving average, relative to the
 /// mean vertical force (H itself is near zero when frictionless).
@@ -74,17 +46,13 @@ fn run_ironing(name: &str) -> (tempfile::TempDir, Vec<(&'static str, History, Re
     let masters = ["facet", "b3", "b4"]
         .into_iter()
         .map(|m| {
-            let h = history(&out.join(format!("{name}-{m}.forces.csv")));
+            let h = history(&out.join(format!("{name}-{m}.forces.csv")), "die_top", "z", SLIDE_START, TRAVEL);
             let r = Results::read(&out.join(format!("{name}-{m}.scres"))).unwrap();
             assert_eq!(r.status, RunStatus::Completed, "{name}-{m}");
             (m, h, r)
         })
         .collect();
     (dir, masters)
-}
-
-fn newton_and_cutbacks(r: &Results) -> (usize, u32) {
-    (r.increments.iter().map(|i| i.info.iterations.len() - 1).sum(), r.increments.iter().map(|i| i.info.cutbacks).sum())
 }
 
 /// Pins (2026-11-23): (master, V oscillation RMS, H ripple RMS / V, Newton corrections,

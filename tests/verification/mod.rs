@@ -6,3 +6,4 @@ mod friction;
 mod paper_examples;
 mod ironing;
 mod shallow_ironing;
+mod sliding;

@@ -13,10 +13,10 @@
 
 use serde_yaml::{Mapping, Value};
 
-use splinecontact::format::csv::Table;
 use splinecontact::format::scres::{Results, RunStatus};
 use splinecontact::post::oscillation::oscillation;
 
+use super::sliding::{history, newton_and_cutbacks, History};
 use crate::common::{repo, run, stderr, tempdir};
 
 /// The indenter slides 10 over t ∈ [1, 2]; the foundation's element length along x is 12 / 60.
@@ -61,17 +61,9 @@ fn derived_pipeline(name: &str) -> String {
     serde_yaml::to_string(&doc).unwrap()
 }
 
-struct Run {
-    /// Travel 10 (t − 1) and the reaction on the indenter top (V = −R_y, H = R_x).
-    s: Vec<f64>,
-    v: Vec<f64>,
-    h: Vec<f64>,
-    /// |Σ tangential| / |Σ normal| contact force.
-    t_over_n: Vec<f64>,
-    results: Results,
-}
-
-fn solve(name: &str) -> Run {
+/// Runs the derived pipeline of `name`: the sliding's histories (travel
+/// 10 (t − 1), V = −R_y, H = R_x on the indenter top) and the results.
+fn solve(name: &str) -> (History, Results) {
     let dir = tempdir();
     for d in ["meshes", "pipelines"] {
         std::fs::create_dir_all(dir.path().join(d)).unwrap();
@@ -81,31 +73,18 @@ fn solve(name: &str) -> Run {
     let o = run("sc-pipeline", &["-q", "pipelines/test.yaml"], dir.path());
     assert!(o.status.success(), "{name}: {}", stderr(&o));
     let out = dir.path().join("pipelines/out");
-    let t = Table::read(&out.join(format!("{name}-b4.forces.csv"))).unwrap();
-    let col = |n: &str| t.column(n).unwrap_or_else(|| panic!("{name}: no column {n}"));
-    let (lf, ry, rx) = (col("load_factor"), col("reaction:indenter_top:y"), col("reaction:indenter_top:x"));
-    let c = [0, 1, 2].map(|k| col(&format!("contact:contact:{}", ["x", "y", "z"][k])));
-    let tg = [0, 1, 2].map(|k| col(&format!("tangential:contact:{}", ["x", "y", "z"][k])));
-    let norm = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-    let mut r = Run { s: vec![], v: vec![], h: vec![], t_over_n: vec![], results: Results::read(&out.join(format!("{name}-b4.scres"))).unwrap() };
-    for row in t.rows.iter().filter(|row| row[lf] >= 1.0 - 1e-9) {
-        r.s.push(SLIDE * (row[lf] - 1.0));
-        r.v.push(-row[ry]);
-        r.h.push(row[rx]);
-        let tv = tg.map(|k| row[k]);
-        r.t_over_n.push(norm(tv) / norm([0, 1, 2].map(|k| row[c[k]] - tv[k])));
-    }
-    assert_eq!(r.results.status, RunStatus::Completed, "{name}");
-    assert!((r.s.last().unwrap() - 5.0).abs() < 1e-9, "{name}: the run ends at t = 1.5");
-    r
+    let h = history(&out.join(format!("{name}-b4.forces.csv")), "indenter_top", "y", 1.0, SLIDE);
+    let results = Results::read(&out.join(format!("{name}-b4.scres"))).unwrap();
+    assert_eq!(results.status, RunStatus::Completed, "{name}");
+    assert!((h.s.last().unwrap() - 5.0).abs() < 1e-9, "{name}: the run ends at t = 1.5");
+    (h, results)
 }
 
 /// Checks every run shares against its pins; V and H at the end (t = 1.5).
-fn check(name: &str, r: &Run, pin: &Pin) -> (f64, f64) {
+fn check(name: &str, (r, results): &(History, Results), pin: &Pin) -> (f64, f64) {
     let (v, h) = (*r.v.last().unwrap(), *r.h.last().unwrap());
     let osc = oscillation(&r.s, &r.v, ELEMENT, STEADY.0, STEADY.1).unwrap();
-    let its: usize = r.results.increments.iter().map(|i| i.info.iterations.len() - 1).sum();
-    let cut: u32 = r.results.increments.iter().map(|i| i.info.cutbacks).sum();
+    let (its, cut) = newton_and_cutbacks(results);
     eprintln!("{name}-b4: V(1.5) {v:.2}, H(1.5) {h:.3}, H/V {:.4}, V oscillation {:.3e} (p2p {:.3e}), {its} Newton corrections, {cut} cutbacks", h / v, osc.rms, osc.peak_to_peak);
     // published at t = 1.5 (six codes, benchmarks.md): V between 337 and 421 N/mm
     assert!((337.0..=421.0).contains(&v), "{name}: V(1.5) = {v} outside the published 337–421");
@@ -131,8 +110,9 @@ fn shallow_ironing_frictionless_bspline() {
 #[test]
 fn shallow_ironing_coulomb_bspline() {
     let name = "shallow_ironing";
-    let r = solve(name);
-    let (v, h) = check(name, &r, &PIN_COULOMB);
+    let run = solve(name);
+    let (v, h) = check(name, &run, &PIN_COULOMB);
+    let r = &run.0;
     // the published H/V at t = 1.5 is 0.30–0.53
     assert!((0.30..=0.53).contains(&(h / v)), "{name}: H/V(1.5) = {} outside the published 0.30–0.53", h / v);
     // Steady sliding, every pressed node slides: Σ|T| = μ Σ|N| exactly (return
