@@ -21,7 +21,9 @@
 //! ```text
 //! ∂²g_N = N_α ⊗ Δξ̄^α + ā^{αβ} T_β ⊗ N_α − ā^{αγ} b̄_γβ T_α ⊗ Δξ̄^β
 //! ```
-//! (rows: δu, columns: Δu; symmetric, it is the Hessian of g_N). The derivation is in
+//! (rows: δu, columns: Δu; symmetric, it is the Hessian of g_N). A node in contact
+//! with a crease of a facet master (`sp.clamped`) is evaluated by the dual-number
+//! element of [`super::friction`] with no friction. The derivation is in
 //! `docs/theory.md`; the tests check `K` against central differences of `r` with the
 //! slave node re-projected at every perturbation.
 
@@ -153,6 +155,12 @@ pub fn normal_contact(
         // touching, not pressed: closed-branch stiffness only
         k.ger(law.eps_n * a_s, &view(&nv, m), &view(&nv, m), 1.0);
         return Ok(ContactState { g_n: g, t_n: 0.0, active: false });
+    }
+    if sp.on_crease() {
+        // contact with a crease of a facet set: the normal follows the distance
+        // vector, ξ̄ moves only along the crease (see `super::friction`)
+        let st = super::friction::frictional_contact(xs, sp, law, &super::friction::FrictionLaw::NONE, r, k)?;
+        return Ok(ContactState { g_n: st.g_n, t_n: st.t_n, active: st.active });
     }
     let t = trial;
     // Δξ̄^α = D^{αβ} (T_β − g N_β)·Δu,  D = (ā_αβ − g b̄_αβ)⁻¹

@@ -91,12 +91,14 @@ impl Projector {
         }
     }
     /// With the master element held (a frozen search): a facet slave projects onto
-    /// its last cell's continued bilinear map; a B-spline slave as usual (the patch
+    /// its last cell's continued bilinear map, a slave in crease contact onto the same
+    /// crease (`last`: its previous projection); a B-spline slave as usual (the patch
     /// is one smooth map, there is no element to hold).
-    fn project_frozen(&self, p: &Vec3, prev: Option<[usize; 2]>) -> (Projection, Option<[usize; 2]>) {
+    fn project_frozen(&self, p: &Vec3, prev: Option<[usize; 2]>, last: &Projection) -> (Projection, Option<[usize; 2]>) {
         match (self, prev) {
             (Self::Facet(pr), Some(c)) => {
-                let (proj, cell) = pr.project_on_cell(p, c);
+                let crease = [0, 1].map(|al| last.clamped[al].then_some(last.xi[al]));
+                let (proj, cell) = pr.project_on_cell(p, c, crease);
                 (proj, Some(cell))
             }
             _ => self.project(p, prev),
@@ -192,7 +194,12 @@ impl PairSolver {
         let (a, b) = (pair.net.a, pair.net.b);
         let projector = match pair.master_kind {
             MasterKind::Bspline => Projector::BSpline(BSplineProjector::new(BSplinePatch::new(a, b, pair.orders[0], pair.orders[1]).map_err(err)?, &x_net).map_err(err)?),
-            MasterKind::Facet => Projector::Facet(FacetProjector::new(FacetSurface::new(a, b).map_err(err)?, &x_net).map_err(err)?),
+            MasterKind::Facet => {
+                let mut p = FacetProjector::new(FacetSurface::new(a, b).map_err(err)?, &x_net).map_err(err)?;
+                // convective slip (eq. 4.7) is not defined with ξ̄ pinned to a crease
+                p.crease_contact = def.settings.mu == 0.0;
+                Projector::Facet(p)
+            }
         };
         let h_master = def.h_master;
         let settings = def.settings;
@@ -209,7 +216,7 @@ impl PairSolver {
             areas,
             lambda_n: vec![0.0; n],
             lambda_committed: vec![0.0; n],
-            projections: vec![Projection { xi: [0.0; 2], x_bar: Vec3::zeros(), g: f64::INFINITY, inside: false, iterations: 0, converged: false }; n],
+            projections: vec![Projection { xi: [0.0; 2], x_bar: Vec3::zeros(), g: f64::INFINITY, inside: false, iterations: 0, converged: false, clamped: [false; 2] }; n],
             points: vec![SurfacePoint::default(); n],
             cells: vec![None; n],
             x_slave: vec![Vec3::zeros(); n],
@@ -250,7 +257,7 @@ impl PairSolver {
             .zip(self.x_slave.par_iter())
             .with_min_len(64)
             .for_each(|(((proj, sp), cell), xs)| {
-                let (pr, c) = if frozen { projector.project_frozen(xs, *cell) } else { projector.project(xs, *cell) };
+                let (pr, c) = if frozen { projector.project_frozen(xs, *cell, proj) } else { projector.project(xs, *cell) };
                 *proj = pr;
                 *cell = c;
                 if proj.converged {
@@ -261,7 +268,13 @@ impl PairSolver {
                 // closest-point conditions hold, and keep the node in contact.
                 if proj.converged && !proj.inside {
                     let d = xs - proj.x_bar;
-                    let overhang = (d - sp.n_bar * d.dot(&sp.n_bar)).norm();
+                    let overhang = if proj.clamped.iter().any(|&c| c) {
+                        // on a crease the distance vector also leans across it: measure
+                        // only along the directions held on the patch edge
+                        (0..2).filter(|&al| proj.xi[al] <= 0.0 || proj.xi[al] >= 1.0).map(|al| d.dot(&sp.a_alpha[al]).abs() / sp.a_alpha[al].norm()).fold(0.0, f64::max)
+                    } else {
+                        (d - sp.n_bar * d.dot(&sp.n_bar)).norm()
+                    };
                     if overhang <= edge_tolerance {
                         let margin = [0, 1].map(|al| 2.0 * edge_tolerance / sp.a_alpha[al].norm().max(1e-300));
                         let ext = projector.project_extended(xs, proj.xi, c, margin);
@@ -270,6 +283,9 @@ impl PairSolver {
                             *sp = projector.evaluate(proj.xi, c);
                         }
                     }
+                }
+                if proj.converged {
+                    sp.hold_on_crease(xs, proj.clamped);
                 }
             });
         for s in 0..self.slaves.len() {

@@ -137,13 +137,18 @@ pub struct FacetProjector {
     tree: SpanTree,
     scale: f64,
     pub options: ProjectionOptions,
+    /// Whether a node in a dead zone is in contact with the crease (edge or vertex,
+    /// the default) or, with `false`, with the continued plane of its kept facet. The
+    /// convective friction law (eq. 4.7) measures slip by the motion of ξ̄, which a
+    /// crease pins, so frictional pairs use the continued planes.
+    pub crease_contact: bool,
 }
 
 impl FacetProjector {
     pub fn new(facets: FacetSurface, x: &[Vec3]) -> Result<Self, SplineError> {
         facets.check_control_net(x)?;
         let tree = SpanTree::new(facets.n_cells(), [2, 2]);
-        let mut s = Self { facets, x: Vec::new(), tree, scale: 0.0, options: ProjectionOptions::default() };
+        let mut s = Self { facets, x: Vec::new(), tree, scale: 0.0, options: ProjectionOptions::default(), crease_contact: true };
         s.update(x)?;
         Ok(s)
     }
@@ -186,7 +191,8 @@ impl FacetProjector {
         newton(|xi| self.facets.jet_in_cell(&self.x, cell, xi), p, mid, (lo, hi), [hi[0] - lo[0], hi[1] - lo[1]], o.tol * self.scale, o.max_iterations)
     }
 
-    /// Closest point of the facet set to `p` and the cell it lies on, with
+    /// Closest point of the facet set to `p` (eq. 2.2: on a facet, or on a crease
+    /// where no facet has an orthogonal projection) and the cell it lies on, with
     /// hysteresis: the cell `prev` (used at the last search) is kept while its foot
     /// point is no farther than the best by 1e-6 of the net's size. A node on the
     /// shared edge of two facets (a crease) then keeps one facet and its normal
@@ -205,7 +211,7 @@ impl FacetProjector {
         if let Some(c) = prev.filter(|&c| c != cell) {
             let kept = self.in_cell(p, c);
             // Where the orthogonal ranges of two facets overlap (a penetrating node
-            // near a concave crease) both foot points are local closest points whose
+            // below a convex crease) both foot points are local closest points whose
             // distances differ by little; keeping the previous one while it is within
             // 1e-4 of the net's size stops the node from switching facets (and its gap
             // from jumping) at every Newton iterate. A foot point held on the cell's
@@ -218,21 +224,70 @@ impl FacetProjector {
         }
         // Dead zone: the closest point lies on an interior crease, where no facet has
         // an orthogonal projection (a point below a concave crease, above a convex
-        // one); the gap there is not differentiable and its linearization (eq. 6.5)
-        // does not hold. With a kept facet (a search that follows a node), continue
-        // its plane (its bilinear map beyond its edge) until the node reaches the
-        // orthogonal range of a neighbour; without one, the closest point stands.
-        if let Some(kept) = prev.filter(|_| self.on_interior_crease(p, &res)) {
-            for c in [kept, cell] {
-                let ext = self.newton_on_cell_map(p, c);
-                if ext.converged && self.orthogonal(p, &ext) {
-                    res = ext;
-                    cell = c;
-                    break;
+        // one). The contact is then with the crease itself (its edge, or a vertex):
+        // g = ±‖p − x̄‖ along the distance vector, which turns continuously from one
+        // facet's normal to the next's as the node crosses the zone (a continued facet
+        // plane makes the gap jump where the node reaches the neighbour's range).
+        // Without crease contact (frictional pairs), a kept facet's plane is continued
+        // until the node reaches the orthogonal range of a neighbour.
+        if !self.crease_contact {
+            if let Some(kept) = prev.filter(|_| self.on_interior_crease(p, &res)) {
+                for c in [kept, cell] {
+                    let ext = self.newton_on_continued_cell(p, c, [None; 2]);
+                    if ext.converged && self.orthogonal(p, &ext) {
+                        res = ext;
+                        cell = c;
+                        break;
+                    }
                 }
             }
         }
-        (finish(p, &res, self.options.outside_tol * self.scale), cell)
+        (self.finish_facet(p, &res), cell)
+    }
+
+    /// The foot point is held on a cell edge shared with another cell (a bound in a
+    /// direction where ξ is not on the patch's edge).
+    fn on_interior_crease(&self, p: &Vec3, res: &NewtonResult) -> bool {
+        let ortho = self.orthogonal_in(p, res);
+        res.converged && (0..2).any(|al| !ortho[al] && res.xi[al] > 1e-12 && res.xi[al] < 1.0 - 1e-12)
+    }
+
+    /// Bounded Newton on `cell`'s bilinear map continued one cell width beyond each
+    /// edge it shares with another cell (not beyond the patch's edges: a node there is
+    /// outside, or within the edge tolerance, `PairSolver::search`); in a direction
+    /// with `crease[α] = Some(ξ^α)` the foot point is held at that ξ^α.
+    fn newton_on_continued_cell(&self, p: &Vec3, cell: [usize; 2], crease: [Option<f64>; 2]) -> NewtonResult {
+        let (mut lo, mut hi) = self.facets.cell_bounds(cell);
+        let width = [hi[0] - lo[0], hi[1] - lo[1]];
+        for al in 0..2 {
+            if let Some(edge) = crease[al] {
+                (lo[al], hi[al]) = (edge, edge);
+            } else {
+                lo[al] = (lo[al] - width[al]).max(0.0);
+                hi[al] = (hi[al] + width[al]).min(1.0);
+            }
+        }
+        let o = &self.options;
+        let start = [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])];
+        newton(|xi| self.facets.jet_in_cell(&self.x, cell, xi), p, start, (lo, hi), width, o.tol * self.scale, o.max_iterations)
+    }
+
+    /// The [`Projection`] of a Newton result on a cell: `clamped[α]` where the foot
+    /// point is held on a cell edge shared with another cell (a crease), and there
+    /// the signed distance g = ±‖p − x̄‖ (sign of the facet's normal side). Without
+    /// crease contact, the plain projection (g along the cell's normal).
+    fn finish_facet(&self, p: &Vec3, res: &NewtonResult) -> Projection {
+        let mut pr = finish(p, res, self.options.outside_tol * self.scale);
+        if !self.crease_contact {
+            return pr;
+        }
+        let ortho = self.orthogonal_in(p, res);
+        pr.clamped = [0, 1].map(|al| res.converged && !ortho[al] && res.xi[al] > 1e-12 && res.xi[al] < 1.0 - 1e-12);
+        if pr.clamped[0] || pr.clamped[1] {
+            let len = (p - res.jet.x).norm();
+            pr.g = if pr.g < 0.0 { -len } else { len };
+        }
+        pr
     }
 
     /// Whether the foot point satisfies the closest-point condition (p − x̄)·ā_α = 0
@@ -245,26 +300,6 @@ impl FacetProjector {
 
     fn orthogonal(&self, p: &Vec3, res: &NewtonResult) -> bool {
         self.orthogonal_in(p, res).iter().all(|&o| o)
-    }
-
-    /// The foot point is held on a cell edge shared with another cell (a bound in a
-    /// direction where ξ is not on the patch's edge).
-    fn on_interior_crease(&self, p: &Vec3, res: &NewtonResult) -> bool {
-        let ortho = self.orthogonal_in(p, res);
-        res.converged && (0..2).any(|al| !ortho[al] && res.xi[al] > 1e-12 && res.xi[al] < 1.0 - 1e-12)
-    }
-
-    /// Bounded Newton on `cell`'s bilinear map continued one cell width beyond each
-    /// edge it shares with another cell (not beyond the patch's edges: a node there is
-    /// outside, or within the edge tolerance, `PairSolver::search`).
-    fn newton_on_cell_map(&self, p: &Vec3, cell: [usize; 2]) -> NewtonResult {
-        let (mut lo, mut hi) = self.facets.cell_bounds(cell);
-        let width = [hi[0] - lo[0], hi[1] - lo[1]];
-        for al in 0..2 {
-            lo[al] = (lo[al] - width[al]).max(0.0);
-            hi[al] = (hi[al] + width[al]).min(1.0);
-        }
-        self.newton_on_map(p, cell, lo, hi)
     }
 
     /// Closest point on `cell`'s bilinear map extended beyond the patch edge by up to
@@ -280,7 +315,7 @@ impl FacetProjector {
                 hi[al] += margin[al];
             }
         }
-        finish(p, &self.newton_on_map(p, cell, lo, hi), self.options.outside_tol * self.scale)
+        self.finish_facet(p, &self.newton_on_map(p, cell, lo, hi))
     }
 
     /// Closest point on `cell`'s bilinear map continued over one cell width beyond
@@ -288,16 +323,19 @@ impl FacetProjector {
     /// frozen search, see `PairSolver::freeze`). Across a crease the foot point then
     /// moves on the continued plane of its facet instead of jumping to the
     /// neighbour's, so the contact residual stays differentiable while Newton
-    /// finishes the iterate.
+    /// finishes the iterate. A node held in crease contact (`crease[α] = Some(ξ^α)`,
+    /// its foot point on that cell edge) keeps ξ^α there and moves only along the
+    /// crease, so its gap stays the distance to that edge (or vertex).
     ///
     /// A node that has left the continued map's range (its foot point held on the
     /// range's bound: it moved more than a cell away) is not held: it gets the
     /// regular search, as a held node could otherwise pass undetected through
     /// another facet.
-    pub fn project_on_cell(&self, p: &Vec3, cell: [usize; 2]) -> (Projection, [usize; 2]) {
-        let res = self.newton_on_cell_map(p, cell);
-        if res.converged && self.orthogonal(p, &res) {
-            (finish(p, &res, self.options.outside_tol * self.scale), cell)
+    pub fn project_on_cell(&self, p: &Vec3, cell: [usize; 2], crease: [Option<f64>; 2]) -> (Projection, [usize; 2]) {
+        let res = self.newton_on_continued_cell(p, cell, crease);
+        let ortho = self.orthogonal_in(p, &res);
+        if res.converged && (0..2).all(|al| ortho[al] || crease[al].is_some()) {
+            (self.finish_facet(p, &res), cell)
         } else {
             self.project_keeping(p, Some(cell))
         }
@@ -399,6 +437,59 @@ mod tests {
                 let jump = (n_plus - n_minus).norm();
                 assert!(jump > 0.9 * jump_expected, "facet normal jump {jump} at ξ¹={xb}");
                 assert!((jump - jump_expected).abs() < 1e-6, "facet jump {jump} vs 2 sin(Δθ/2) = {jump_expected}");
+            }
+        }
+    }
+
+    /// Below a concave crease (a valley, n̄ = +z) a point swept across the dead zone:
+    /// with crease contact its foot point stays on the crease (ξ¹ clamped), g = −‖d‖
+    /// equals minus the distance to the facet set (brute force) everywhere, and g is
+    /// continuous; with continued planes (frictional pairs) g jumps where the point
+    /// reaches the next facet's range.
+    #[test]
+    fn dead_zone_gap_is_continuous_with_crease_contact() {
+        let (na, nb) = (7, 3);
+        let x: Vec<Vec3> = (0..na * nb).map(|k| {
+            let (i, j) = ((k % na) as f64, (k / na) as f64);
+            Vec3::new(i, j, 0.1 * (i - 3.0).powi(2))
+        }).collect();
+        let facets = FacetSurface::new(na, nb).unwrap();
+        // the net is extruded along y and the points lie at y = 1 (ξ² = ½): brute force
+        // over that line, spacing 1e-5 in x (distance error ≤ 1e-10 near the crease)
+        let m = 600_000;
+        let dense: Vec<Vec3> = (0..=m).map(|i| facets.point(&x, [i as f64 / m as f64, 0.5])).collect();
+        // the crease x = 4 (slopes 0.1 and 0.3: 0.197 rad); 0.1 below it the dead zone
+        // spans x ∈ 4 + 0.1·[−0.0995, 0.287]·(…) ≈ [3.99, 4.029]
+        for crease_contact in [true, false] {
+            let mut proj = FacetProjector::new(facets.clone(), &x).unwrap();
+            proj.crease_contact = crease_contact;
+            let (mut prev, mut last_g, mut jumps, mut clamped) = (None, f64::NAN, 0.0f64, 0);
+            for k in 0..=120 {
+                let p = Vec3::new(3.97 + 0.08 * k as f64 / 120.0, 1.0, 0.0);
+                let (pr, cell) = proj.project_keeping(&p, prev);
+                prev = Some(cell);
+                assert!(pr.inside && pr.converged, "{p:?}");
+                if pr.clamped[0] {
+                    clamped += 1;
+                    assert!(crease_contact && (pr.xi[0] - 4.0 / 6.0).abs() < 1e-12 && !pr.clamped[1]);
+                    let brute = dense.iter().map(|q| (q - p).norm()).fold(f64::INFINITY, f64::min);
+                    // kept from the previous search within the hysteresis 1e-6 L
+                    // (L ≈ 6.4, the net's diagonal); searched afresh: exact
+                    assert!((-pr.g - brute).abs() < 1e-5, "{p:?}: g {} vs distance {brute}", pr.g);
+                    assert!((-proj.project(&p).g - brute).abs() < 1e-9, "{p:?}: fresh search vs distance {brute}");
+                    assert!((pr.g + (p - pr.x_bar).norm()).abs() < 1e-14);
+                }
+                if k > 0 {
+                    jumps = jumps.max((pr.g - last_g).abs());
+                }
+                last_g = pr.g;
+            }
+            // step 0.08/120 = 6.7e-4 in x: a continuous g changes by at most that
+            eprintln!("crease contact {crease_contact}: {clamped} of 121 on the crease, largest step in g {jumps:.2e}");
+            if crease_contact {
+                assert!(clamped > 10 && jumps < 1e-3, "{clamped} {jumps}");
+            } else {
+                assert!(clamped == 0 && jumps > 2e-3, "{clamped} {jumps}");
             }
         }
     }

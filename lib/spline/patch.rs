@@ -105,6 +105,10 @@ pub struct SurfacePoint {
     pub b_ab: Mat2,
     /// Nonzero basis functions and their derivatives (eqs. 6.2–6.3).
     pub basis: SurfaceBasis,
+    /// Facet masters: `clamped[α]` when the foot point is held on an interior cell
+    /// edge in direction α (the closest point lies on a crease of the facet set, see
+    /// [`Self::hold_on_crease`]); always `[false, false]` on a B-spline patch.
+    pub clamped: [bool; 2],
 }
 
 impl SurfacePoint {
@@ -117,6 +121,33 @@ impl SurfacePoint {
         self.a_ab = Mat2::new(a1.dot(&a1), g12, g12, a2.dot(&a2));
         let det = self.a_ab[(0, 0)] * self.a_ab[(1, 1)] - g12 * g12;
         self.a_inv = Mat2::new(self.a_ab[(1, 1)], -g12, -g12, self.a_ab[(0, 0)]) / det;
+        let b = |al: usize, be: usize| self.a_alpha_beta[al][be].dot(&self.n_bar);
+        self.b_ab = Mat2::new(b(0, 0), b(0, 1), b(1, 0), b(1, 1));
+        self.clamped = [false; 2];
+    }
+
+    /// Whether the foot point is held on a crease (some ξ^α clamped).
+    pub fn on_crease(&self) -> bool {
+        self.clamped[0] || self.clamped[1]
+    }
+
+    /// The closest point of `x_s` lies on a crease of a facet set (an interior cell
+    /// edge, `clamped[α]` in the direction it bounds, or a vertex: both), where no
+    /// facet has an orthogonal projection (a point below a concave crease). The
+    /// closest-point condition (x_s − x̄)·ā_α = 0 then holds only in the free
+    /// directions, and the contact normal is the direction of the distance vector,
+    /// `n̄ = (x_s − x̄)/g_N` with `g_N = ±‖x_s − x̄‖` signed by the side of the facet's
+    /// own normal (eq. 2.2 on the facet set). b̄_αβ is recomputed with this n̄; the
+    /// metric stays that of the facet. No-op when nothing is clamped or x_s lies on x̄.
+    pub fn hold_on_crease(&mut self, x_s: &Vec3, clamped: [bool; 2]) {
+        let d = x_s - self.x_bar;
+        let len = d.norm();
+        if !(clamped[0] || clamped[1]) || len == 0.0 {
+            return;
+        }
+        let g = if d.dot(&self.n_bar) < 0.0 { -len } else { len };
+        self.n_bar = d / g;
+        self.clamped = clamped;
         let b = |al: usize, be: usize| self.a_alpha_beta[al][be].dot(&self.n_bar);
         self.b_ab = Mat2::new(b(0, 0), b(0, 1), b(1, 0), b(1, 1));
     }

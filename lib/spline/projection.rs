@@ -51,6 +51,9 @@ pub struct Projection {
     pub iterations: usize,
     /// Whether the stationarity tolerance was reached.
     pub converged: bool,
+    /// Facet sets: ξ^α held on an interior cell edge (the closest point lies on a
+    /// crease, g = ±‖x − x̄‖; see [`crate::spline::SurfacePoint::hold_on_crease`]).
+    pub clamped: [bool; 2],
 }
 
 /// Tunables of the projection.
@@ -196,6 +199,7 @@ pub(crate) fn finish(p: &Vec3, res: &NewtonResult, outside_tol_len: f64) -> Proj
         inside: !is_outside(p, res.xi, cur, outside_tol_len),
         iterations: res.iterations,
         converged: res.converged,
+        clamped: [false; 2],
     }
 }
 
@@ -405,7 +409,7 @@ impl BSplineProjector {
         });
         match best {
             Some((_, res)) => finish(p, &res, o.outside_tol * self.scale),
-            None => Projection { xi: [f64::NAN; 2], x_bar: Vec3::from_element(f64::NAN), g: f64::NAN, inside: false, iterations: 0, converged: false },
+            None => Projection { xi: [f64::NAN; 2], x_bar: Vec3::from_element(f64::NAN), g: f64::NAN, inside: false, iterations: 0, converged: false, clamped: [false; 2] },
         }
     }
 
