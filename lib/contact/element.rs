@@ -257,6 +257,27 @@ pub(crate) mod tests {
         xi
     }
 
+    /// The element's unknowns `u = [x_s; x_A]` (A over `nodes`).
+    pub(crate) fn element_dofs(xs: &Vec3, x_all: &[Vec3], nodes: &[usize]) -> Vec<f64> {
+        let mut u = vec![0.0; 3 * (1 + nodes.len())];
+        for c in 0..3 {
+            u[c] = xs[c];
+            for (a, &nd) in nodes.iter().enumerate() {
+                u[3 * (1 + a) + c] = x_all[nd][c];
+            }
+        }
+        u
+    }
+
+    /// The slave position and the whole net with the element's unknowns set to `v`.
+    pub(crate) fn with_element_dofs(v: &[f64], x_all: &[Vec3], nodes: &[usize]) -> (Vec3, Vec<Vec3>) {
+        let mut x = x_all.to_vec();
+        for (a, &nd) in nodes.iter().enumerate() {
+            x[nd] = Vec3::new(v[3 * (1 + a)], v[3 * (1 + a) + 1], v[3 * (1 + a) + 2]);
+        }
+        (Vec3::new(v[0], v[1], v[2]), x)
+    }
+
     /// Central differences of an element residual over u = [x_s; x_A] (the control
     /// points of `nodes`), the slave re-projected near `xi0` at every perturbation;
     /// `residual(x_s, sp, r)` evaluates the element at the perturbed state. h = 1e-7 ×
@@ -264,20 +285,10 @@ pub(crate) mod tests {
     /// ~ε|r|/h ≈ 1e-9 |r|, projection round-off ~1e-16 in ξ̄ → 1e-9, all ≪ 1e-6 of K.
     pub(crate) fn fd_element(surf: &MasterSurface, x_all: &[Vec3], nodes: &[usize], xs0: &Vec3, xi0: [f64; 2], residual: impl Fn(&Vec3, &SurfacePoint, &mut DVector<f64>)) -> DMatrix<f64> {
         let m = 3 * (1 + nodes.len());
-        let mut u = vec![0.0; m];
-        for c in 0..3 {
-            u[c] = xs0[c];
-            for (a, &nd) in nodes.iter().enumerate() {
-                u[3 * (1 + a) + c] = x_all[nd][c];
-            }
-        }
+        let u = element_dofs(xs0, x_all, nodes);
         fd_jacobian(
             |v, out| {
-                let mut x = x_all.to_vec();
-                for (a, &nd) in nodes.iter().enumerate() {
-                    x[nd] = Vec3::new(v[3 * (1 + a)], v[3 * (1 + a) + 1], v[3 * (1 + a) + 2]);
-                }
-                let xs = Vec3::new(v[0], v[1], v[2]);
+                let (xs, x) = with_element_dofs(v, x_all, nodes);
                 let xi = reproject(surf, &x, &xs, xi0);
                 let (sp, _) = surf.evaluate_local(&x, xi);
                 assert_eq!(sp.basis.nodes(), nodes, "perturbation left the span");

@@ -282,7 +282,7 @@ fn evaluate(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::contact::element::tests::{curved_net, fd_element, TestMaster};
+    use crate::contact::element::tests::{curved_net, element_dofs, fd_element, with_element_dofs, TestMaster};
     use crate::contact::element::MasterSurface;
     use crate::fem::fd::rel_err;
     use crate::spline::BSplinePatch;
@@ -392,13 +392,7 @@ mod tests {
             assert!((sp0.n_bar - (xs0 - sp0.x_bar) / p0.g).norm() < 1e-12);
             let nodes = sp0.basis.nodes().to_vec();
             let m = 3 * (1 + nodes.len());
-            let mut u = vec![0.0; m];
-            for c in 0..3 {
-                u[c] = xs0[c];
-                for (a, &nd) in nodes.iter().enumerate() {
-                    u[3 * (1 + a) + c] = x_all[nd][c];
-                }
-            }
+            let u = element_dofs(&xs0, &x_all, &nodes);
             let back = [p0.xi[0] - 0.01, p0.xi[1] + 0.02];
             let laws = [
                 (NormalLaw { lambda_n: 0.0, eps_n: 1e3, area: 0.7, touch: 0.0 }, FrictionLaw::NONE, None),
@@ -424,11 +418,7 @@ mod tests {
                 }
                 let fd = fd_jacobian(
                     |v, out| {
-                        let mut x = x_all.clone();
-                        for (a, &nd) in nodes.iter().enumerate() {
-                            x[nd] = Vec3::new(v[3 * (1 + a)], v[3 * (1 + a) + 1], v[3 * (1 + a) + 2]);
-                        }
-                        let xs = Vec3::new(v[0], v[1], v[2]);
+                        let (xs, x) = with_element_dofs(v, &x_all, &nodes);
                         let sp = at(&x, &xs);
                         assert_eq!(sp.basis.nodes(), &nodes[..]);
                         let (mut rr, mut kk) = (DVector::zeros(m), DMatrix::zeros(0, 0));
