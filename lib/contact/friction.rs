@@ -380,8 +380,7 @@ mod tests {
             assert!(p0.inside && p0.converged && p0.clamped == want, "{xi_c:?}: {p0:?}");
             assert!((p0.g + (xs0 - p0.x_bar).norm()).abs() < 1e-14 && (p0.x_bar - x_c).norm() < 1e-3, "{p0:?}");
             let at = |x_net: &[Vec3], xs: &Vec3| {
-                let mut pr = FacetProjector::new(facets.clone(), x_net).unwrap();
-                pr.update(x_net).unwrap();
+                let pr = FacetProjector::new(facets.clone(), x_net).unwrap();
                 let (p, c) = pr.project_keeping(xs, Some(cell0));
                 assert_eq!((p.clamped, c), (want, cell0), "perturbation changed the crease state");
                 let mut sp = pr.evaluate_in_cell(p.xi, c);

@@ -180,15 +180,15 @@ impl FacetProjector {
     /// Bounded Newton on one cell.
     fn in_cell(&self, p: &Vec3, cell: [usize; 2]) -> NewtonResult {
         let (lo, hi) = self.facets.cell_bounds(cell);
-        self.newton_on_map(p, cell, lo, hi)
+        self.newton_on_map(p, cell, lo, hi, [hi[0] - lo[0], hi[1] - lo[1]])
     }
 
     /// Newton on `cell`'s bilinear map over the box ξ ∈ [lo, hi] (which may reach
-    /// beyond the cell), started at its middle.
-    fn newton_on_map(&self, p: &Vec3, cell: [usize; 2], lo: [f64; 2], hi: [f64; 2]) -> NewtonResult {
+    /// beyond the cell), started at its middle, steps at most `max_step` per direction.
+    fn newton_on_map(&self, p: &Vec3, cell: [usize; 2], lo: [f64; 2], hi: [f64; 2], max_step: [f64; 2]) -> NewtonResult {
         let o = &self.options;
         let mid = [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])];
-        newton(|xi| self.facets.jet_in_cell(&self.x, cell, xi), p, mid, (lo, hi), [hi[0] - lo[0], hi[1] - lo[1]], o.tol * self.scale, o.max_iterations)
+        newton(|xi| self.facets.jet_in_cell(&self.x, cell, xi), p, mid, (lo, hi), max_step, o.tol * self.scale, o.max_iterations)
     }
 
     /// Closest point of the facet set to `p` (eq. 2.2: on a facet, or on a crease
@@ -245,11 +245,15 @@ impl FacetProjector {
         (self.finish_facet(p, &res), cell)
     }
 
-    /// The foot point is held on a cell edge shared with another cell (a bound in a
-    /// direction where ξ is not on the patch's edge).
-    fn on_interior_crease(&self, p: &Vec3, res: &NewtonResult) -> bool {
+    /// The directions in which the foot point is held on a cell edge shared with
+    /// another cell (a bound where ξ is not on the patch's edge): a crease.
+    fn crease_directions(&self, p: &Vec3, res: &NewtonResult) -> [bool; 2] {
         let ortho = self.orthogonal_in(p, res);
-        res.converged && (0..2).any(|al| !ortho[al] && res.xi[al] > 1e-12 && res.xi[al] < 1.0 - 1e-12)
+        [0, 1].map(|al| res.converged && !ortho[al] && res.xi[al] > 1e-12 && res.xi[al] < 1.0 - 1e-12)
+    }
+
+    fn on_interior_crease(&self, p: &Vec3, res: &NewtonResult) -> bool {
+        self.crease_directions(p, res).iter().any(|&c| c)
     }
 
     /// Bounded Newton on `cell`'s bilinear map continued one cell width beyond each
@@ -267,9 +271,8 @@ impl FacetProjector {
                 hi[al] = (hi[al] + width[al]).min(1.0);
             }
         }
-        let o = &self.options;
-        let start = [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])];
-        newton(|xi| self.facets.jet_in_cell(&self.x, cell, xi), p, start, (lo, hi), width, o.tol * self.scale, o.max_iterations)
+        // a held direction has an empty box; the steps stay bounded by the cell width
+        self.newton_on_map(p, cell, lo, hi, width)
     }
 
     /// The [`Projection`] of a Newton result on a cell: `clamped[α]` where the foot
@@ -281,8 +284,7 @@ impl FacetProjector {
         if !self.crease_contact {
             return pr;
         }
-        let ortho = self.orthogonal_in(p, res);
-        pr.clamped = [0, 1].map(|al| res.converged && !ortho[al] && res.xi[al] > 1e-12 && res.xi[al] < 1.0 - 1e-12);
+        pr.clamped = self.crease_directions(p, res);
         if pr.clamped[0] || pr.clamped[1] {
             let len = (p - res.jet.x).norm();
             pr.g = if pr.g < 0.0 { -len } else { len };
@@ -315,7 +317,7 @@ impl FacetProjector {
                 hi[al] += margin[al];
             }
         }
-        self.finish_facet(p, &self.newton_on_map(p, cell, lo, hi))
+        self.finish_facet(p, &self.newton_on_map(p, cell, lo, hi, [hi[0] - lo[0], hi[1] - lo[1]]))
     }
 
     /// Closest point on `cell`'s bilinear map continued over one cell width beyond

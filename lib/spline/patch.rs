@@ -121,9 +121,14 @@ impl SurfacePoint {
         self.a_ab = Mat2::new(a1.dot(&a1), g12, g12, a2.dot(&a2));
         let det = self.a_ab[(0, 0)] * self.a_ab[(1, 1)] - g12 * g12;
         self.a_inv = Mat2::new(self.a_ab[(1, 1)], -g12, -g12, self.a_ab[(0, 0)]) / det;
+        self.complete_curvature();
+        self.clamped = [false; 2];
+    }
+
+    /// b̄_αβ = ā_{α,β}·n̄ with the current n̄ (eq. 4.12).
+    fn complete_curvature(&mut self) {
         let b = |al: usize, be: usize| self.a_alpha_beta[al][be].dot(&self.n_bar);
         self.b_ab = Mat2::new(b(0, 0), b(0, 1), b(1, 0), b(1, 1));
-        self.clamped = [false; 2];
     }
 
     /// Whether the foot point is held on a crease (some ξ^α clamped).
@@ -148,8 +153,7 @@ impl SurfacePoint {
         let g = if d.dot(&self.n_bar) < 0.0 { -len } else { len };
         self.n_bar = d / g;
         self.clamped = clamped;
-        let b = |al: usize, be: usize| self.a_alpha_beta[al][be].dot(&self.n_bar);
-        self.b_ab = Mat2::new(b(0, 0), b(0, 1), b(1, 0), b(1, 1));
+        self.complete_curvature();
     }
 
     /// n̄_{,α} = −b̄_αβ ā^{βγ} ā_γ (Weingarten equations), `[α]`.
