@@ -19,9 +19,12 @@
 //         18 x 8 (0.5 x 0.5) the die's lowest row (x = 2.5) and its middle row
 //         (y = 2) sat exactly on master node rows — on facet creases, where a node
 //         pressed straight down flips between the two facets at every iterate.
-//   die   ndt x ndy x 1 = 36 x 6 x 1 (the half circle split uniformly in angle: arc
-//         length 0.26 on the outer face; 0.87 along y; one element through the 0.2
-//         thickness): its outer face die_outer (37 x 7 nodes) is the slave. Its node
+//   die   ndt x ndy x 1 = 72 x 6 x 1 (the half circle split uniformly in angle: arc
+//         length 0.13 on the outer face; 0.87 along y; one element through the 0.2
+//         thickness): its outer face die_outer (73 x 7 nodes) is the slave. With 36
+//         elements (0.26 apart) V rippled at the slave's spacing as die nodes entered
+//         and left the contact zone, a ripple no master removes (frictionless B-spline
+//         [4, 4] V oscillation 2.2e-4; 1.05e-4 with 72: docs/validation.md). Its node
 //         rows along y sit at -0.6, 0.267, 1.133, 2, 2.867, 3.733, 4.6: 0.6 beyond the
 //         slab's sides or 0.27 inside them. A slave row near the master's edge crosses
 //         it while the slab deforms, already penetrated, and its force switches on or
@@ -40,7 +43,7 @@ DefineConstant[
   nsx = {20, Name "Parameters/nsx"},      // slab elements along x (sliding; see below)
   nsy = {7, Name "Parameters/nsy"},       // slab elements along y (width; see below)
   nsz = {6, Name "Parameters/nsz"},       // slab elements through its thickness
-  ndt = {36, Name "Parameters/ndt"},      // die elements around its half circle
+  ndt = {72, Name "Parameters/ndt"},      // die elements around its half circle
   ndy = {6, Name "Parameters/ndy"}        // die elements along its axis (see below)
 ];
 

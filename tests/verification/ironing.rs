@@ -55,7 +55,7 @@ fn run_ironing(name: &str) -> (tempfile::TempDir, Vec<(&'static str, History, Re
     (dir, masters)
 }
 
-/// Pins (2026-11-23): (master, V oscillation RMS, H ripple RMS / V, Newton corrections,
+/// Pins (2026-11-25, die of 72 × 6 elements): (master, V oscillation RMS, H ripple RMS / V, Newton corrections,
 /// cutbacks). Oscillation figures ±30 %: they are differences of nearly equal forces
 /// (1e-4–1e-3 of V) and move with the Newton tolerance and the platform's rounding,
 /// but a change of the master's geometry or of the contact element moves them by
@@ -86,14 +86,18 @@ fn check(name: &str, masters: &[(&'static str, History, Results)], pins: &[Pin])
 fn ironing3d_frictionless_facet_against_bspline() {
     let (_dir, masters) = run_ironing("ironing3d_frictionless");
     check("frictionless", &masters, &PINS_FRICTIONLESS);
+    // the cubic B-spline master: V and H ripple at most 1/5 of the facets' (the
+    // issue's target; measured 0.086 and 0.14 — the quadratic one gives 0.47 and 0.36)
+    let v_rms: Vec<f64> = masters.iter().map(|(_, h, _)| oscillation(&h.s, &h.v, ELEMENT, STEADY.0, STEADY.1).unwrap().rms).collect();
     let ripple: Vec<f64> = masters.iter().map(|(_, h, _)| h_ripple(h)).collect();
-    // the cubic B-spline master: H ripple at most 1/5 of the facets' (the target)
+    assert!(v_rms[2] <= 0.2 * v_rms[0], "B-spline [4, 4] V oscillation {:.3e} vs facet {:.3e}", v_rms[2], v_rms[0]);
     assert!(ripple[2] <= 0.2 * ripple[0], "B-spline [4, 4] H ripple {:.3e} vs facet {:.3e}", ripple[2], ripple[0]);
     for (m, h, _) in &masters {
-        // frictionless steady sliding: H ≈ 0 (measured |mean H| / V ≤ 4e-4, facet)
+        // frictionless steady sliding: H ≈ 0 (measured |mean H| / V ≤ 2e-9, facet; it was
+        // 4e-4 with the 36-element die): 1e-5 leaves room for the Newton tolerance (1e-8 of the reactions)
         let hm = oscillation(&h.s, &h.h, ELEMENT, STEADY.0, STEADY.1).unwrap().mean;
         let vm = oscillation(&h.s, &h.v, ELEMENT, STEADY.0, STEADY.1).unwrap().mean;
-        assert!(hm.abs() < 1e-3 * vm, "{m}: mean H / V = {}", hm / vm);
+        assert!(hm.abs() < 1e-5 * vm, "{m}: mean H / V = {}", hm / vm);
     }
 }
 
@@ -102,20 +106,20 @@ fn ironing3d_coulomb_facet_against_bspline() {
     let (_dir, masters) = run_ironing("ironing3d");
     check("mu 0.3", &masters, &PINS_COULOMB);
     // the cubic B-spline master: V and H ripple at most 1/5 of the facets' (the
-    // issue's target; measured 0.17 and 0.08 — the quadratic one gives 0.47 and 0.32)
+    // issue's target; measured 0.16 and 0.12 — the quadratic one gives 0.31 and 0.34)
     let v_rms: Vec<f64> = masters.iter().map(|(_, h, _)| oscillation(&h.s, &h.v, ELEMENT, STEADY.0, STEADY.1).unwrap().rms).collect();
     let ripple: Vec<f64> = masters.iter().map(|(_, h, _)| h_ripple(h)).collect();
     assert!(v_rms[2] <= 0.2 * v_rms[0], "B-spline [4, 4] V oscillation {:.3e} vs facet {:.3e}", v_rms[2], v_rms[0]);
     assert!(ripple[2] <= 0.2 * ripple[0], "B-spline [4, 4] H ripple {:.3e} vs facet {:.3e}", ripple[2], ripple[0]);
     for (m, h, _) in &masters {
-        // Steady sliding, every active node slides: H/V → μ = 0.3; measured 0.2946
-        // (B4) – 0.2972 (facet): the die's shell flexes, the normal force tilts, and
+        // Steady sliding, every active node slides: H/V → μ = 0.3; measured 0.2943
+        // (B4) – 0.2965 (facet): the die's shell flexes, the normal force tilts, and
         // the slab ahead of the die is lifted: within 0.01 of μ.
         let hm = oscillation(&h.s, &h.h, ELEMENT, STEADY.0, STEADY.1).unwrap().mean;
         let vm = oscillation(&h.s, &h.v, ELEMENT, STEADY.0, STEADY.1).unwrap().mean;
         assert!((hm / vm - 0.3).abs() < 0.01, "{m}: H/V = {}", hm / vm);
         // Σ|T| = μ Σ|N| exactly (return mapping); |ΣT| / |ΣN| differs from μ by the
-        // spread of the nodes' normals and sliding directions: measured 0.2992
+        // spread of the nodes' normals and sliding directions: measured 0.2993
         // (B4) – 0.3003 (facet, whose normals jump): within 1 % of μ.
         for (s, r) in h.s.iter().zip(&h.t_over_n) {
             if (STEADY.0..=STEADY.1).contains(s) {
@@ -126,13 +130,13 @@ fn ironing3d_coulomb_facet_against_bspline() {
 }
 
 const PINS_FRICTIONLESS: [Pin; 3] = [
-    Pin { master: "facet", v_rms: 6.86e-4, h_rms: 3.07e-3, newton: 329, cutbacks: 0 },
-    Pin { master: "b3", v_rms: 7.93e-4, h_rms: 1.11e-3, newton: 251, cutbacks: 0 },
-    Pin { master: "b4", v_rms: 2.15e-4, h_rms: 2.18e-4, newton: 251, cutbacks: 0 },
+    Pin { master: "facet", v_rms: 1.22e-3, h_rms: 2.18e-3, newton: 291, cutbacks: 0 },
+    Pin { master: "b3", v_rms: 5.74e-4, h_rms: 7.91e-4, newton: 240, cutbacks: 0 },
+    Pin { master: "b4", v_rms: 1.05e-4, h_rms: 2.99e-4, newton: 240, cutbacks: 0 },
 ];
 
 const PINS_COULOMB: [Pin; 3] = [
-    Pin { master: "facet", v_rms: 1.67e-3, h_rms: 3.43e-3, newton: 391, cutbacks: 0 },
-    Pin { master: "b3", v_rms: 7.93e-4, h_rms: 1.15e-3, newton: 300, cutbacks: 0 },
-    Pin { master: "b4", v_rms: 2.81e-4, h_rms: 2.84e-4, newton: 300, cutbacks: 0 },
+    Pin { master: "facet", v_rms: 1.28e-3, h_rms: 2.19e-3, newton: 366, cutbacks: 1 },
+    Pin { master: "b3", v_rms: 3.96e-4, h_rms: 7.38e-4, newton: 295, cutbacks: 1 },
+    Pin { master: "b4", v_rms: 2.00e-4, h_rms: 2.65e-4, newton: 288, cutbacks: 0 },
 ];
