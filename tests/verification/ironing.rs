@@ -55,7 +55,7 @@ fn run_ironing(name: &str) -> (tempfile::TempDir, Vec<(&'static str, History, Re
     (dir, masters)
 }
 
-/// Pins (2026-11-25, die of 72 × 6 elements): (master, V oscillation RMS, H ripple RMS / V, Newton corrections,
+/// Pins (2026-11-23, die of 72 × 6 elements): (master, V oscillation RMS, H ripple RMS / V, Newton corrections,
 /// cutbacks). Oscillation figures ±30 %: they are differences of nearly equal forces
 /// (1e-4–1e-3 of V) and move with the Newton tolerance and the platform's rounding,
 /// but a change of the master's geometry or of the contact element moves them by
