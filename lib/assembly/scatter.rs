@@ -323,6 +323,11 @@ impl Assembly {
         &self.values
     }
 
+    /// The same, to add terms assembled elsewhere (the stabilisation's diagonal).
+    pub fn values_mut(&mut self) -> &mut [f64] {
+        &mut self.values
+    }
+
     /// Full residual (all `3·n_nodes` dofs) from the last assembly.
     pub fn residual(&self) -> &[f64] {
         &self.residual

@@ -37,6 +37,9 @@ pub struct PairSettings {
     /// Coulomb coefficient μ and tangential penalty ε_T (μ = 0: frictionless).
     pub mu: f64,
     pub eps_t: f64,
+    /// Master-surface stabilisation factor η (0: off): an artificial inertia of
+    /// stiffness η ε_N Ā_s on the master net's nodes (`solver::stabilization`).
+    pub stabilization: f64,
 }
 
 impl PairSettings {
@@ -330,6 +333,21 @@ impl PairSolver {
     pub fn release(&mut self) {
         self.frozen = false;
         self.held_slip.iter_mut().for_each(|h| *h = None);
+    }
+
+    /// The master net's mesh nodes (control points of a B-spline master, facet corners).
+    pub fn net_nodes(&self) -> &[u32] {
+        &self.net
+    }
+
+    /// The stiffness c = η ε_N Ā_s of the master-surface stabilisation, Ā_s the slave
+    /// nodes' mean tributary area (0 when the pair has none).
+    pub fn stabilization_stiffness(&self) -> f64 {
+        if self.settings.stabilization <= 0.0 || self.areas.is_empty() {
+            return 0.0;
+        }
+        let mean_area = self.areas.iter().sum::<f64>() / self.areas.len() as f64;
+        self.settings.stabilization * self.settings.eps_n * mean_area
     }
 
     /// Whether freezing holds anything (facet masters; frictional pairs).

@@ -18,8 +18,8 @@ use crate::mesh::Mesh;
 pub const FORMAT: &str = "scres";
 pub const MAJOR: u32 = 1;
 /// 1.1: contact pairs and per-increment contact state (files without them read as
-/// 1.0 did).
-pub const MINOR: u32 = 1;
+/// 1.0 did). 1.2: `stabilization_force` in a pair's increment summary (absent when 0).
+pub const MINOR: u32 = 2;
 
 /// One Newton iteration, as logged.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
@@ -74,6 +74,14 @@ pub struct PairSummary {
     /// and slipping.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub friction: Option<FrictionSummary>,
+    /// Pairs with a master-surface stabilisation (1.2): ‖f‖ of its force on the
+    /// master net's nodes, to compare with `force`.
+    #[serde(default, skip_serializing_if = "is_zero_f64")]
+    pub stabilization_force: f64,
+}
+
+fn is_zero_f64(v: &f64) -> bool {
+    *v == 0.0
 }
 
 fn is_zero_u32(v: &u32) -> bool {

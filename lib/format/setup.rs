@@ -278,6 +278,11 @@ pub struct ContactSetup {
     /// Tangential penalty ε_T (traction per unit elastic slip); default ε_N.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub eps_t: Option<f64>,
+    /// Master-surface stabilisation factor η (0, the default: off): the master net's
+    /// nodes get an artificial inertia of stiffness η ε_N Ā_s against their motion
+    /// extrapolated from the last two increments (`solver::stabilization`).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub stabilization: f64,
 }
 
 fn is_zero(v: &f64) -> bool {

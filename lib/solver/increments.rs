@@ -74,9 +74,14 @@ pub fn forces_csv(results: &Results) -> String {
     for s in &sets {
         out.push_str(&format!(",reaction:{s}:x,reaction:{s}:y,reaction:{s}:z"));
     }
-    for p in &results.pairs {
+    // a pair with a master-surface stabilisation also gets its force ‖f‖
+    let stabilized: Vec<bool> = (0..results.pairs.len()).map(|i| results.increments.iter().any(|inc| inc.info.contact.get(i).is_some_and(|c| c.stabilization_force > 0.0))).collect();
+    for (p, &st) in results.pairs.iter().zip(&stabilized) {
         let n = &p.name;
         out.push_str(&format!(",contact:{n}:x,contact:{n}:y,contact:{n}:z,tangential:{n}:x,tangential:{n}:y,tangential:{n}:z,active:{n},stick:{n},slip:{n},augmentations:{n}"));
+        if st {
+            out.push_str(&format!(",stabilization:{n}"));
+        }
     }
     out.push('\n');
     for (k, inc) in results.increments.iter().enumerate() {
@@ -93,8 +98,11 @@ pub fn forces_csv(results: &Results) -> String {
                         ",{:e},{:e},{:e},{:e},{:e},{:e},{},{},{},{}",
                         c.force[0], c.force[1], c.force[2], t[0], t[1], t[2], c.active, st, sl, c.augmentations
                     ));
+                    if stabilized[i] {
+                        out.push_str(&format!(",{:e}", c.stabilization_force));
+                    }
                 }
-                None => out.push_str(",,,,,,,,,,"),
+                None => out.push_str(if stabilized[i] { ",,,,,,,,,,," } else { ",,,,,,,,,," }),
             }
         }
         out.push('\n');
@@ -128,11 +136,12 @@ fn worst_element(p: &Problem, results: &Results, failure: &IncrementFailure, tri
 /// Per pair: the summary, the state rows and the friction rows.
 type ContactResults = (Vec<PairSummary>, Vec<Vec<[f64; 6]>>, Vec<Vec<[f64; 9]>>);
 
-fn contact_results(newton: &Newton) -> ContactResults {
+fn contact_results(newton: &Newton, u: &[f64]) -> ContactResults {
+    let stabilization = newton.stabilization_forces(u);
     let mut summaries = Vec::with_capacity(newton.contact.len());
     let mut states = Vec::with_capacity(newton.contact.len());
     let mut friction = Vec::with_capacity(newton.contact.len());
-    for c in &newton.contact {
+    for (k, c) in newton.contact.iter().enumerate() {
         let f = c.total_force();
         let max_penetration = c.max_penetration();
         let elastic_slip = c.max_elastic_slip();
@@ -150,6 +159,7 @@ fn contact_results(newton: &Newton) -> ContactResults {
                 let (stick, slip) = c.n_stick_slip();
                 FrictionSummary { tangential_force: [t[0], t[1], t[2]], stick: stick as u32, slip: slip as u32, elastic_slip }
             }),
+            stabilization_force: stabilization[k],
         });
         friction.push(if c.settings.frictional() {
             (0..c.slaves.len())
@@ -242,7 +252,7 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
                     };
                     summary.iterations += conv.iterations.len().saturating_sub(1);
                     let reactions = newton.reactions().into_iter().map(|(set, force)| Reaction { set, force }).collect();
-                    let (summaries, states, friction) = contact_results(newton);
+                    let (summaries, states, friction) = contact_results(newton, &u);
                     for c in &newton.contact {
                         if let (n, Some(node)) = c.failed_projections() {
                             log.line(&format!(
@@ -254,6 +264,10 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
                         }
                     }
                     for s in &summaries {
+                        if s.stabilization_force > 0.0 {
+                            let f = (s.force[0].powi(2) + s.force[1].powi(2) + s.force[2].powi(2)).sqrt();
+                            log.line(&format!("increment {}/{n_inc}: pair '{}': stabilisation force {:.3e} on the master surface (contact force {:.3e})", k + 1, s.pair, s.stabilization_force, f));
+                        }
                         if !s.penetration_converged {
                             log.line(&format!(
                                 "increment {}/{n_inc}: warning: pair '{}' still penetrates {:.3e} after {} augmentations (raise max_augmentations or eps_n)",
@@ -267,6 +281,7 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
                     for pair in &mut newton.contact {
                         pair.commit();
                     }
+                    newton.commit_increment(&u, lambda);
                     results.increments.push(Increment {
                         info: IncrementInfo { load_factor: lambda, cutbacks: cutbacks_this, iterations: conv.iterations, reactions, seconds_output: 0.0, contact: summaries },
                         u: u.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),

@@ -1,6 +1,7 @@
 //! Solvers: the linear-solver interface and its faer direct backend ([`linear`]),
 //! the static problem ([`problem`]) and its load curves ([`amplitude`]), Newton–Raphson for one increment ([`newton`]),
-//! the augmented Lagrangian's Uzawa loop ([`uzawa`]), load
+//! the augmented Lagrangian's Uzawa loop ([`uzawa`]), the master-surface
+//! stabilisation ([`stabilization`]), load
 //! stepping with cutbacks ([`increments`]), what the user sees ([`log`]), and a
 //! timing benchmark on a clamped elastic cube ([`bench`]).
 
@@ -11,6 +12,7 @@ pub mod linear;
 pub mod log;
 pub mod newton;
 pub mod problem;
+pub mod stabilization;
 pub mod uzawa;
 
 pub use linear::{

@@ -16,6 +16,7 @@ use std::time::Instant;
 use nalgebra::{DMatrix, DVector, Vector3};
 
 use super::problem::Problem;
+use super::stabilization::Stabilization;
 use crate::assembly::{Assembly, AssemblyError, ElementFailure, NodeGroups, Pattern, PatternError, DOFS_PER_NODE};
 use crate::contact::element::ContactElementError;
 use crate::contact::pair::{PairError, PairSolver};
@@ -100,6 +101,8 @@ pub struct Newton<'p> {
     pub step_halvings: u32,
     /// Corrections halved by the line search (all solves).
     pub line_search_steps: u32,
+    /// The master-surface stabilisation of the pairs that ask for one.
+    pub stabilization: Option<Stabilization>,
     /// The iteration at which the current solve held the contact search's master
     /// elements, and why ([`PairSolver::freeze`]); `None` while they may change.
     pub frozen_at: Option<(u32, &'static str)>,
@@ -137,6 +140,7 @@ impl<'p> Newton<'p> {
         linear.analyse(pattern.symbolic(), symmetry)?;
         let n = DOFS_PER_NODE * problem.n_nodes();
         let n_free = pattern.n_free();
+        let stabilization = Stabilization::new(problem, &contact);
         Ok(Self {
             problem,
             settings,
@@ -153,6 +157,7 @@ impl<'p> Newton<'p> {
             symmetry,
             step_halvings: 0,
             line_search_steps: 0,
+            stabilization,
             frozen_at: None,
         })
     }
@@ -202,6 +207,25 @@ impl<'p> Newton<'p> {
     /// solve; `frozen_at` keeps saying what the last solve did).
     fn release_contact(&mut self) {
         self.contact.iter_mut().for_each(PairSolver::release);
+    }
+
+    /// Accept the converged state `u` at `lambda` (the stabilisation's history).
+    pub fn commit_increment(&mut self, u: &[f64], lambda: f64) {
+        if let Some(s) = &mut self.stabilization {
+            s.commit(u, lambda);
+        }
+    }
+
+    /// The stabilisation force ‖f‖ on each pair's master net at `u` (0 for a pair
+    /// without one), in the order of `contact`.
+    pub fn stabilization_forces(&self, u: &[f64]) -> Vec<f64> {
+        let mut out = vec![0.0; self.contact.len()];
+        if let Some(s) = &self.stabilization {
+            for (k, f) in s.forces(u) {
+                out[k] = f;
+            }
+        }
+        out
     }
 
     /// Slave nodes pressed into the master at the last search, over all pairs.
@@ -267,6 +291,10 @@ impl<'p> Newton<'p> {
         for ((out, r), f) in self.residual.iter_mut().zip(full).zip(&self.f_ext) {
             *out = r - f;
         }
+        if let Some(s) = &self.stabilization {
+            s.add_residual(u, &mut self.residual);
+            s.add_tangent(&self.pattern, self.assembly.values_mut());
+        }
         Ok(())
     }
 
@@ -278,6 +306,9 @@ impl<'p> Newton<'p> {
             u[pr.dof] = p.amplitudes[pr.amplitude as usize].at(lambda) * pr.value;
         }
         p.external_force(lambda, &mut self.f_ext);
+        if let Some(s) = &mut self.stabilization {
+            s.predict(lambda);
+        }
         let ext_norm = self.f_ext.iter().map(|v| v * v).sum::<f64>().sqrt();
         let mut log = Vec::new();
         let mut energy0 = 0.0;

@@ -169,6 +169,9 @@ fn contact_definitions(mesh: &Mesh, pairs: &[ContactPair], setup: &SolveSetup, f
             (mu, None) if mu > 0.0 => eps_n, // default: the normal penalty
             (_, e) => e.unwrap_or(0.0),
         };
+        if !(c.stabilization.is_finite() && c.stabilization >= 0.0) {
+            return Err(bad(format!("stabilization must be zero or positive, found {}", c.stabilization)));
+        }
         let areas = tributary_areas(mesh, &pair.slave_nodes, (pair.slave_kind == SlaveKind::FaceSet).then_some(pair.slave.as_str()));
         let penetration_tolerance = match (c.penetration_tolerance, c.penetration_tolerance_relative) {
             (Some(_), Some(_)) => return Err(bad("give `penetration_tolerance` or `penetration_tolerance_relative`, not both".into())),
@@ -178,7 +181,7 @@ fn contact_definitions(mesh: &Mesh, pairs: &[ContactPair], setup: &SolveSetup, f
         };
         out.push(ContactDefinition {
             pair: pair.clone(),
-            settings: PairSettings { eps_n, enforcement: c.enforcement, penetration_tolerance, max_augmentations: c.max_augmentations, mu: c.mu, eps_t },
+            settings: PairSettings { eps_n, enforcement: c.enforcement, penetration_tolerance, max_augmentations: c.max_augmentations, mu: c.mu, eps_t, stabilization: c.stabilization },
             eps_n_default,
             areas,
             h_master: h,

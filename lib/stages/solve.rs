@@ -52,7 +52,7 @@ pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, 
     for (c, def) in newton.contact.iter().zip(&problem.contact) {
         let s = &c.settings;
         log.line(&format!(
-            "contact pair '{}': {} slave nodes, {} master, ε_N = {:e}{}, {}{}{}",
+            "contact pair '{}': {} slave nodes, {} master, ε_N = {:e}{}, {}{}{}{}",
             c.name,
             c.slaves.len(),
             c.master_kind.name(),
@@ -66,7 +66,12 @@ pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, 
                 crate::format::setup::Enforcement::Penalty => String::new(),
                 _ => format!(" (penetration tolerance {:e}, at most {} augmentations)", s.penetration_tolerance, s.max_augmentations),
             },
-            if s.frictional() { format!(", Coulomb friction μ = {}, ε_T = {:e}", s.mu, s.eps_t) } else { ", frictionless".into() }
+            if s.frictional() { format!(", Coulomb friction μ = {}, ε_T = {:e}", s.mu, s.eps_t) } else { ", frictionless".into() },
+            if s.stabilization > 0.0 {
+                format!(", master-surface stabilisation η = {} (c = η ε_N Ā_s = {:.4e} on {} master nodes)", s.stabilization, c.stabilization_stiffness(), c.net_nodes().len())
+            } else {
+                String::new()
+            }
         ));
     }
     log.line(&format!(
