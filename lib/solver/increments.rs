@@ -13,6 +13,7 @@ use super::log::{IterationEvent, SolveLog};
 use super::newton::{gauss_stresses, IncrementFailure, Newton};
 use super::uzawa::solve_augmented;
 use crate::contact::pair::SlaveStatus;
+use crate::format::sccontact::MasterKind;
 use crate::format::scres::{FrictionSummary, PairSummary};
 use crate::format::setup::Enforcement;
 use super::problem::Problem;
@@ -24,7 +25,7 @@ use crate::format::stage::{write_atomic, StageError};
 /// The solve stopped.
 #[derive(Debug, thiserror::Error)]
 pub enum SolveError {
-    #[error("solve stopped at increment {increment} (load factor {load_factor:.6}, last converged {last_converged:.6}) after {cutbacks} cutbacks: {failure}{worst}; the {kept} converged increments are in {results}")]
+    #[error("solve stopped at increment {increment} (load factor {load_factor:.6}, last converged {last_converged:.6}) after {cutbacks} cutbacks: {failure}{worst}; the {kept} converged increments are in {results}{hint}")]
     Diverged {
         increment: usize,
         load_factor: f64,
@@ -34,6 +35,9 @@ pub enum SolveError {
         worst: String,
         kept: usize,
         results: String,
+        /// What to try, when there is something specific (a facet master without
+        /// the stabilisation).
+        hint: String,
     },
     #[error(transparent)]
     Write(#[from] StageError),
@@ -352,5 +356,18 @@ fn stop(p: &Problem, trial: &[f64], results: &mut Results, out: &Outputs, log: &
         worst,
         kept: results.increments.len(),
         results: out.results.display().to_string(),
+        hint: facet_hint(p),
     }
+}
+
+/// A stopped solve with a facet master that has no stabilisation: say it exists.
+fn facet_hint(p: &Problem) -> String {
+    let facets: Vec<&str> = p.contact.iter().filter(|c| c.pair.master_kind == MasterKind::Facet && c.settings.stabilization == 0.0).map(|c| c.pair.name.as_str()).collect();
+    if facets.is_empty() {
+        return String::new();
+    }
+    format!(
+        " (pair '{}' has a facet master: if it is the softer body under a sliding slave, its quasi-static path can need a snap that Newton cannot follow; `stabilization: 0.15` in its contact entry or a B-spline master can help: docs/pipelines.md)",
+        facets.join("', '")
+    )
 }

@@ -136,6 +136,8 @@ increments: {count: 5, max_cutbacks: 1}\n";
     assert!(!tags.is_empty() && tags.iter().all(|t| [163, 168, 173].contains(t)), "{err}");
     // within a few iterations, not at max_iterations
     assert!(!err.contains("did not converge in 25 iterations"), "{err}");
+    // and it points at what can help a facet master (docs/pipelines.md)
+    assert!(err.contains("pair 'contact' has a facet master") && err.contains("`stabilization: 0.15`"), "{err}");
     // stabilised (the defaults): converges, every increment, no cutback
     std::fs::write(dir.path().join("s2.yaml"), setup).unwrap();
     let o = run("sc-solve", &["c.sccontact", "--setup", "s2.yaml", "-o", "r2.scres"], dir.path());
