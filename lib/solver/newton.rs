@@ -41,8 +41,17 @@ pub enum IncrementFailure {
     Contact { iteration: u32, pair: String, node_tag: u64, error: ContactElementError },
     #[error("iteration {iteration}: {message}")]
     ContactSetup { iteration: u32, message: String },
-    #[error("iteration {iteration}: the contact configuration cycles between two states (relative residual {residual:.3e}): slave nodes {nodes} alternate between in and out of contact or between master elements")]
-    ContactCycling { iteration: u32, residual: f64, nodes: String },
+    #[error("iteration {iteration}: the contact configuration cycles between {} states (relative residual {residual:.3e}): slave nodes {nodes} alternate between in and out of contact or between master elements", period_name(*.period))]
+    ContactCycling { iteration: u32, residual: f64, nodes: String, period: u32 },
+}
+
+/// "two", "three", "four" (the cycle lengths [`Newton`] detects).
+fn period_name(p: u32) -> &'static str {
+    match p {
+        2 => "two",
+        3 => "three",
+        _ => "four",
+    }
 }
 
 /// A local (element-level) failure during assembly.
@@ -315,8 +324,9 @@ impl<'p> Newton<'p> {
         let mut energy = f64::INFINITY;
         let mut first_residual = 0.0;
         let mut max_reaction: f64 = 0.0;
-        // contact configurations of the last three iterates, to detect a 2-cycle
-        let mut configs: [Vec<(u32, bool, u32)>; 3] = Default::default();
+        // contact configurations of the last five iterates, to detect a cycle of
+        // period 2, 3 or 4
+        let mut configs: [Vec<(u32, bool, u32)>; 5] = Default::default();
         let mut cycling = 0u32;
         self.release_contact();
         self.frozen_at = None;
@@ -430,30 +440,34 @@ impl<'p> Newton<'p> {
                 on_iteration(&row);
                 return Err(IncrementFailure::Diverged { iteration, residual });
             }
-            // Period-2 cycle of the contact configuration (C = A, B, A, B, …) for three
-            // iterations in a row: Newton will not settle; cut the increment back now.
+            // A cycle of the contact configuration of period 2, 3 or 4 (C = A, B, A, B,
+            // … or A, B, C, D, A, …) for three iterations in a row: Newton will not
+            // settle; cut the increment back now.
             if !self.contact.is_empty() {
                 configs.rotate_right(1);
                 configs[0].clear();
                 for pair in &self.contact {
                     pair.configuration(&mut configs[0]);
                 }
-                let two_cycle = iteration >= 2 && configs[0] == configs[2] && configs[0] != configs[1];
-                cycling = if two_cycle { cycling + 1 } else { 0 };
+                let period = (2..=4u32).find(|&k| iteration >= k && configs[0] == configs[k as usize] && configs[0] != configs[1]);
+                cycling = if period.is_some() { cycling + 1 } else { 0 };
                 // first remedy: hold the master elements and let Newton finish
                 if cycling >= 3 && self.settings.search_updates > 0 && self.freeze_contact(iteration, "the contact configuration cycles") {
                     cycling = 0;
                 } else if cycling >= 3 {
                     let tags = &p.node_tags;
-                    let flipping: Vec<String> = configs[0]
-                        .iter()
-                        .zip(&configs[1])
-                        .filter(|(a, b)| a != b)
+                    let period = period.unwrap_or(2);
+                    // the slaves whose state differs anywhere along the cycle
+                    let flipping: Vec<String> = (0..configs[0].len())
+                        .filter(|&i| (1..period as usize).any(|k| configs[k].get(i) != configs[0].get(i)))
                         .take(8)
-                        .map(|(a, _)| tags.get(a.0 as usize).copied().unwrap_or(a.0 as u64).to_string())
+                        .map(|i| {
+                            let node = configs[0][i].0;
+                            tags.get(node as usize).copied().unwrap_or(node as u64).to_string()
+                        })
                         .collect();
                     on_iteration(&row);
-                    return Err(IncrementFailure::ContactCycling { iteration, residual, nodes: flipping.join(", ") });
+                    return Err(IncrementFailure::ContactCycling { iteration, residual, nodes: flipping.join(", "), period });
                 }
             }
             let t = Instant::now();
