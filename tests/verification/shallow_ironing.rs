@@ -157,7 +157,7 @@ fn shallow_ironing_frictionless_facet_stabilized() {
     let (r, results) = &run;
     // The target: the cubic B-spline master's V oscillation (its pin, held by
     // shallow_ironing_frictionless_bspline on the same mesh and load path) at most 1/5
-    // of the facets'; measured 0.037 (1.50e-4 against 4.09e-3).
+    // of the facets'; measured 0.039 (1.50e-4 against 3.87e-3).
     let osc = oscillation(&r.s, &r.v, ELEMENT, STEADY.0, STEADY.1).unwrap().rms;
     assert!(PIN_FRICTIONLESS.v_rms <= 0.2 * osc, "B-spline [2, 4] V oscillation {:.3e} vs facet {osc:.3e}", PIN_FRICTIONLESS.v_rms);
     // The stabilisation is reported and stays small against the contact force in
@@ -172,11 +172,11 @@ fn shallow_ironing_frictionless_facet_stabilized() {
     assert!(h.abs() < H_LIMIT * v, "{name}: H/V(1.5) = {}", h / v);
 }
 
-/// The facet master's pins (2026-11-23), tolerances as above. Its V(1.5) lies 2.4 %
+/// The facet master's pins (2026-11-23), tolerances as above. Its V(1.5) lies 3.0 %
 /// under the B-spline [2, 4] master's with the same penalty and no stabilisation
 /// (382.8; 376.3 with the same stabilisation): the penalty's penetration and the
 /// stabilisation's share of the load (docs/validation.md).
-const PIN_FACET_FRICTIONLESS: Pin = Pin { v_15: 372.15, v_rms: 4.09e-3, newton: 743, cutbacks: 0 };
+const PIN_FACET_FRICTIONLESS: Pin = Pin { v_15: 371.50, v_rms: 3.87e-3, newton: 747, cutbacks: 0 };
 /// ‖f_stab‖ / ‖F_contact‖ over the sliding: measured at most 0.045 (at the slide's
 /// start, where the extrapolated pressing motion turns into sliding; ~0.02 after).
 const STAB_LIMIT: f64 = 0.07;
