@@ -29,7 +29,10 @@
 //! held on a cell edge or vertex in the clamped directions, n̄ = (x_s − x̄)/g_N and
 //! g_N = ±‖x_s − x̄‖; ξ̄ varies only in the free directions, `D` restricted to them
 //! (see `docs/theory.md`, "Facet dead zones: crease contact"). The frictionless
-//! element routes such a node here with [`FrictionLaw::NONE`].
+//! element routes such a node here with [`FrictionLaw::NONE`]. With friction the
+//! tangential part uses the tangent vectors projected normal to n̄, ã_α = ā_α −
+//! (ā_α·n̄) n̄, and the unrestricted D of their metric, so the friction force turns
+//! with n̄ across the dead zone ("Friction on a crease").
 
 use nalgebra::{DMatrix, DVector};
 
@@ -214,11 +217,20 @@ fn evaluate(
             scale(&cr, Dual::cst(1.0) / dot(&cr, &cr).sqrt())
         };
         let g = dot(&sub(&x_s, &x_bar), &n);
-        let met = [[dot(&a_al[0], &a_al[0]), dot(&a_al[0], &a_al[1])], [dot(&a_al[1], &a_al[0]), dot(&a_al[1], &a_al[1])]];
+        // Friction on a crease: the tangent vectors projected normal to n = d/g_N carry
+        // the tangential traction (metric, return mapping, transfer), so the friction
+        // force turns with n across the dead zone (docs/theory.md, "Friction on a crease")
+        let a_t = if crease && friction.mu > 0.0 { [0, 1].map(|al| sub(&a_al[al], &scale(&n, dot(&a_al[al], &n)))) } else { a_al };
+        let met = [[dot(&a_t[0], &a_t[0]), dot(&a_t[0], &a_t[1])], [dot(&a_t[1], &a_t[0]), dot(&a_t[1], &a_t[1])]];
         let met_inv = inv2(met).ok_or(ContactElementError::FocalPoint { g_n: g0 })?;
         let b = [[dot(&a_ab_v[0][0], &n), dot(&a_ab_v[0][1], &n)], [dot(&a_ab_v[1][0], &n), dot(&a_ab_v[1][1], &n)]];
         let mm = [[met[0][0] - g * b[0][0], met[0][1] - g * b[0][1]], [met[1][0] - g * b[1][0], met[1][1] - g * b[1][1]]];
         let dm = inv_free(mm, sp.clamped).ok_or(ContactElementError::FocalPoint { g_n: g0 })?;
+        // On a crease the tangential traction is passed on through the unrestricted D
+        // (of the projected metric): at the zone's borders it is the facet's own D, so
+        // the friction force is continuous as the node enters and leaves the zone;
+        // ξ̄ itself moves only in the free directions.
+        let dt = if crease && friction.mu > 0.0 { inv2(mm).ok_or(ContactElementError::FocalPoint { g_n: g0 })? } else { dm };
         // normal law (eq. 4.2)
         let t_n = Dual::cst(normal.lambda_n) + g * normal.eps_n;
         // trial tangential traction and return mapping (eqs. 4.6–4.8)
@@ -246,22 +258,22 @@ fn evaluate(
             }
         };
         // slave block: N_s = n̄, ∂ξ̄^α/∂x_s = D^{αβ} ā_β
-        let dxi_s = [0, 1].map(|al| [0, 1, 2].map(|c| dm[al][0] * a_al[0][c] + dm[al][1] * a_al[1][c]));
+        let dxi_s = [0, 1].map(|al| [0, 1, 2].map(|c| dt[al][0] * a_t[0][c] + dt[al][1] * a_t[1][c]));
         for c in 0..3 {
             put(c, t_n * n[c] + t_t[0] * dxi_s[0][c] + t_t[1] * dxi_s[1][c]);
         }
         for a in 0..nc {
             // N_A = −Q_A n̄; w_β,A = −Q_A ā_β + g Q_{A,β} n̄; ∂ξ̄^α/∂x_A = D^{αβ} w_β,A
-            let wa: [D3; 2] = [0, 1].map(|be| [0, 1, 2].map(|c| -qd[a] * a_al[be][c] + g * qad[a][be] * n[c]));
+            let wa: [D3; 2] = [0, 1].map(|be| [0, 1, 2].map(|c| -qd[a] * a_t[be][c] + g * qad[a][be] * n[c]));
             for c in 0..3 {
-                let dxi_a = [dm[0][0] * wa[0][c] + dm[0][1] * wa[1][c], dm[1][0] * wa[0][c] + dm[1][1] * wa[1][c]];
+                let dxi_a = [dt[0][0] * wa[0][c] + dt[0][1] * wa[1][c], dt[1][0] * wa[0][c] + dt[1][1] * wa[1][c]];
                 put(3 * (1 + a) + c, -t_n * qd[a] * n[c] + t_t[0] * dxi_a[0] + t_t[1] * dxi_a[1]);
             }
         }
         if j == m {
             let tv: D3 = [0, 1, 2].map(|c| {
                 let up = [met_inv[0][0] * t_t[0] + met_inv[0][1] * t_t[1], met_inv[1][0] * t_t[0] + met_inv[1][1] * t_t[1]];
-                up[0] * a_al[0][c] + up[1] * a_al[1][c]
+                up[0] * a_t[0][c] + up[1] * a_t[1][c]
             });
             state = Some(FrictionState {
                 g_n: g.v,
@@ -435,6 +447,57 @@ mod tests {
                 assert!(e < 1e-6, "{want:?}: {e:e}");
             }
         }
+    }
+
+    /// A slipping slave swept at constant depth across the dead zone below a concave
+    /// crease (the production projector holds its foot point on the crease there):
+    /// the force on it is continuous, and its component along the sliding direction
+    /// stays μ|t_N| A_s. Passing the tangential traction through the restricted D
+    /// instead (ξ̄ pinned across the crease) drops that component to zero inside the
+    /// zone: a jump of μ|t_N| A_s = 30 at its borders.
+    #[test]
+    fn friction_force_is_continuous_across_a_crease_dead_zone() {
+        use crate::spline::{FacetProjector, FacetSurface};
+        let (na, nb) = (7, 3);
+        // valley extruded along y (n̄ = +z), creases at x = 1 … 5; slopes 0.1 and 0.3 at x = 4
+        let x: Vec<Vec3> = (0..na * nb).map(|k| {
+            let (i, j) = ((k % na) as f64, (k / na) as f64);
+            Vec3::new(i, j, 0.1 * (i - 3.0).powi(2))
+        }).collect();
+        let proj = FacetProjector::new(FacetSurface::new(na, nb).unwrap(), &x).unwrap();
+        let normal = NormalLaw { lambda_n: 0.0, eps_n: 1e3, area: 1.0, touch: 0.0 };
+        // stuck at x = 3.5 and moved on: the trial traction is far beyond μ|t_N| (slip, +x)
+        let fr = FrictionLaw { mu: 0.3, eps_t: 1e3, xi_n: [3.5 / 6.0, 0.5], t_t_n: [0.0; 2], held_slip: None };
+        let (mut prev, mut last, mut jump, mut on_crease) = (None, None::<Vec3>, 0.0f64, 0);
+        // 0.1 below the surface the dead zone spans x ≈ [3.99, 4.03] (facet.rs tests)
+        for k in 0..=120 {
+            let xs = Vec3::new(3.97 + 0.08 * k as f64 / 120.0, 1.0, 0.0);
+            let (p, cell) = proj.project_keeping(&xs, prev);
+            prev = Some(cell);
+            let mut sp = proj.evaluate_in_cell(p.xi, cell);
+            sp.hold_on_crease(&xs, p.clamped);
+            on_crease += usize::from(sp.on_crease());
+            let (mut r, mut kk) = (DVector::zeros(0), DMatrix::zeros(0, 0));
+            let st = frictional_contact(&xs, &sp, &normal, &fr, &mut r, &mut kk).unwrap();
+            assert!(st.active && st.slip, "x = {}: {st:?}", xs.x);
+            let f = -Vec3::new(r[0], r[1], r[2]);
+            // sliding +x: the friction part (normal to n̄, the distance direction on the
+            // crease) points along −x and is μ|t_N| A_s; on the crease it acts along the
+            // held facet's tangent, at most the crease angle (0.197 rad, cos 0.98) off
+            let f_t = f - sp.n_bar * f.dot(&sp.n_bar);
+            let mu_tn = fr.mu * st.t_n.abs() * normal.area;
+            assert!(f_t.x < 0.0 && f_t.norm() > 0.98 * mu_tn && f_t.norm() < (1.0 + 1e-12) * mu_tn, "x = {}: f_t = {f_t:?}, μ|t_N| A = {mu_tn}", xs.x);
+            if let Some(l) = last {
+                jump = jump.max((f - l).norm());
+            }
+            last = Some(f);
+        }
+        // step 6.7e-4 in x; inside the zone the crease normal turns by 0.197 rad over
+        // its width 0.039, so |F| ≈ 105 turns by ≈ 0.35 per step (measured largest step
+        // 0.70); the held facet's tangent without the projection jumps by μ|t_N| A_s ×
+        // 0.197 ≈ 5.8 at the zone's far border (measured 5.79), the restricted D by 30
+        eprintln!("{on_crease} of 121 positions on the crease, largest force step {jump:.3}");
+        assert!(on_crease > 10 && jump < 1.0, "{on_crease} {jump}");
     }
 
     /// The friction force on the slave opposes the slip and is capped at μ|t_N| A_s.

@@ -198,10 +198,7 @@ impl PairSolver {
         let projector = match pair.master_kind {
             MasterKind::Bspline => Projector::BSpline(BSplineProjector::new(BSplinePatch::new(a, b, pair.orders[0], pair.orders[1]).map_err(err)?, &x_net).map_err(err)?),
             MasterKind::Facet => {
-                let mut p = FacetProjector::new(FacetSurface::new(a, b).map_err(err)?, &x_net).map_err(err)?;
-                // convective slip (eq. 4.7) is not defined with ξ̄ pinned to a crease
-                p.crease_contact = def.settings.mu == 0.0;
-                Projector::Facet(p)
+                Projector::Facet(FacetProjector::new(FacetSurface::new(a, b).map_err(err)?, &x_net).map_err(err)?)
             }
         };
         let h_master = def.h_master;

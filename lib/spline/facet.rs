@@ -138,9 +138,9 @@ pub struct FacetProjector {
     scale: f64,
     pub options: ProjectionOptions,
     /// Whether a node in a dead zone is in contact with the crease (edge or vertex,
-    /// the default) or, with `false`, with the continued plane of its kept facet. The
-    /// convective friction law (eq. 4.7) measures slip by the motion of ξ̄, which a
-    /// crease pins, so frictional pairs use the continued planes.
+    /// the default, frictional pairs too: `contact::friction` carries the tangential
+    /// traction across the crease) or, with `false`, with the continued plane of its
+    /// kept facet (kept for comparison in tests).
     pub crease_contact: bool,
 }
 
@@ -446,7 +446,7 @@ mod tests {
     /// Below a concave crease (a valley, n̄ = +z) a point swept across the dead zone:
     /// with crease contact its foot point stays on the crease (ξ¹ clamped), g = −‖d‖
     /// equals minus the distance to the facet set (brute force) everywhere, and g is
-    /// continuous; with continued planes (frictional pairs) g jumps where the point
+    /// continuous; with continued planes (`crease_contact: false`) g jumps where the point
     /// reaches the next facet's range.
     #[test]
     fn dead_zone_gap_is_continuous_with_crease_contact() {

@@ -8,9 +8,9 @@
 //! published band and to the measured value, H/V (frictionless: H ≈ 0), the
 //! tangential / normal contact force, the V oscillation over the sliding, and the
 //! Newton corrections and cutbacks. docs/validation.md, "Shallow ironing", has the
-//! table these numbers come from. The facet master reaches the sliding phase only with
-//! the master-surface stabilisation (the facet chain of
-//! shallow_ironing_frictionless.yaml; with μ = 0.3 it does not yet): docs/validation.md says what was tried.
+//! table these numbers come from. The facet master reaches the end of the sliding only with
+//! the master-surface stabilisation and a penalty (the facet chains of both
+//! pipelines, also run to t = 1.5 here): docs/validation.md says what was tried.
 
 use serde_yaml::{Mapping, Value};
 
@@ -96,7 +96,7 @@ fn check(name: &str, (r, results): &(History, Results), pin: &Pin) -> (f64, f64)
     assert!((v / pin.v_15 - 1.0).abs() < 0.01, "{name}: V(1.5) = {v} (pinned {})", pin.v_15);
     assert!((osc.rms / pin.v_rms - 1.0).abs() < 0.3, "{name}: V oscillation {:.3e} (pinned {:.3e})", osc.rms, pin.v_rms);
     assert!(its as f64 <= 1.25 * pin.newton as f64 + 2.0, "{name}: {its} Newton corrections (pinned {})", pin.newton);
-    assert!(cut <= pin.cutbacks + 2, "{name}: {cut} cutbacks (pinned {})", pin.cutbacks);
+    assert!(cut as f64 <= 1.25 * pin.cutbacks as f64 + 2.0, "{name}: {cut} cutbacks (pinned {})", pin.cutbacks);
     (v, h)
 }
 
@@ -134,7 +134,8 @@ fn shallow_ironing_coulomb_bspline() {
 /// Pins (2026-11-23): V(1.5) ±1 % (above); V oscillation RMS over the travel [2, 5]
 /// ±30 % (a difference of nearly equal forces, 1e-4 of V, that moves with the Newton
 /// tolerance and the platform's rounding, but by factors with the master's
-/// smoothness); Newton corrections + 25 % (+2); cutbacks + 2.
+/// smoothness); Newton corrections and cutbacks + 25 % (+2: the facet runs snap over
+/// creases, and a snap's path moves with the platform's rounding).
 struct Pin {
     v_15: f64,
     v_rms: f64,
@@ -160,16 +161,47 @@ fn shallow_ironing_frictionless_facet_stabilized() {
     // of the facets'; measured 0.039 (1.50e-4 against 3.87e-3).
     let osc = oscillation(&r.s, &r.v, ELEMENT, STEADY.0, STEADY.1).unwrap().rms;
     assert!(PIN_FRICTIONLESS.v_rms <= 0.2 * osc, "B-spline [2, 4] V oscillation {:.3e} vs facet {osc:.3e}", PIN_FRICTIONLESS.v_rms);
-    // The stabilisation is reported and stays small against the contact force in
-    // every sliding increment (`STAB_LIMIT`).
+    check_stabilization(results);
+    // Frictionless, yet the faceted crater resists the sliding: the nodes snap over
+    // the creases and the energy they release is dissipated (`H_LIMIT`).
+    assert!(h.abs() < H_LIMIT * v, "{name}: H/V(1.5) = {}", h / v);
+}
+
+/// The stabilisation is reported and stays small against the contact force in every
+/// sliding increment (`STAB_LIMIT`).
+fn check_stabilization(results: &Results) {
     for inc in results.increments.iter().filter(|i| i.info.load_factor > 1.0 + 1e-9) {
         let c = &inc.info.contact[0];
         let f = (c.force[0].powi(2) + c.force[1].powi(2) + c.force[2].powi(2)).sqrt();
         assert!(c.stabilization_force > 0.0 && c.stabilization_force <= STAB_LIMIT * f, "t = {}: stabilisation force {:.3e} against a contact force {f:.3e}", inc.info.load_factor, c.stabilization_force);
     }
-    // Frictionless, yet the faceted crater resists the sliding: the nodes snap over
-    // the creases and the energy they release is dissipated (`H_LIMIT`).
-    assert!(h.abs() < H_LIMIT * v, "{name}: H/V(1.5) = {}", h / v);
+}
+
+/// The facet chain of pipelines/shallow_ironing.yaml (μ = 0.3; penalty, master-surface
+/// stabilisation 0.15 and friction on creases; docs/validation.md), up to t = 1.5.
+#[test]
+fn shallow_ironing_coulomb_facet_stabilized() {
+    let name = "shallow_ironing";
+    let run = solve(name, "facet");
+    let (v, h) = check(&format!("{name}-facet"), &run, &PIN_FACET_COULOMB);
+    let (r, results) = &run;
+    // the target against the cubic B-spline master's pin (as above; measured
+    // 0.020: 1.07e-4 against 5.37e-3)
+    let osc = oscillation(&r.s, &r.v, ELEMENT, STEADY.0, STEADY.1).unwrap().rms;
+    assert!(PIN_COULOMB.v_rms <= 0.2 * osc, "B-spline [2, 4] V oscillation {:.3e} vs facet {osc:.3e}", PIN_COULOMB.v_rms);
+    check_stabilization(results);
+    assert!((0.30..=0.53).contains(&(h / v)), "{name}: H/V(1.5) = {} outside the published 0.30–0.53", h / v);
+    // Every pressed node slides in steady sliding and the facets' normals are straight
+    // lines in z: Σ|T| = μ Σ|N| to the return mapping's round-off (measured 0.3000 over
+    // the travel [2, 5]). H/V swings more than the B-spline master's (0.316–0.362:
+    // the snaps over the creases add resistance), so it is held to the published band.
+    for (i, s) in r.s.iter().enumerate() {
+        if (STEADY.0..=STEADY.1).contains(s) {
+            assert!((r.t_over_n[i] - 0.3).abs() < 1e-3, "{name}: tangential / normal contact force {} at travel {s}", r.t_over_n[i]);
+            let hv = r.h[i] / r.v[i];
+            assert!((0.30..=0.53).contains(&hv), "{name}: H/V = {hv} at travel {s}");
+        }
+    }
 }
 
 /// The facet master's pins (2026-11-23), tolerances as above. Its V(1.5) lies 3.0 %
@@ -177,6 +209,10 @@ fn shallow_ironing_frictionless_facet_stabilized() {
 /// (382.8; 376.3 with the same stabilisation): the penalty's penetration and the
 /// stabilisation's share of the load (docs/validation.md).
 const PIN_FACET_FRICTIONLESS: Pin = Pin { v_15: 371.50, v_rms: 3.87e-3, newton: 747, cutbacks: 0 };
+/// With μ = 0.3 (2026-11-23), tolerances as above: V(1.5) inside the published band,
+/// 6.6 % under the B-spline [2, 4] master's (399.9; the penalty and the stabilisation,
+/// as without friction).
+const PIN_FACET_COULOMB: Pin = Pin { v_15: 373.39, v_rms: 5.37e-3, newton: 893, cutbacks: 16 };
 /// ‖f_stab‖ / ‖F_contact‖ over the sliding: measured at most 0.045 (at the slide's
 /// start, where the extrapolated pressing motion turns into sliding; ~0.02 after).
 const STAB_LIMIT: f64 = 0.07;
