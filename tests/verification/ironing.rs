@@ -106,7 +106,7 @@ fn ironing3d_coulomb_facet_against_bspline() {
     let (_dir, masters) = run_ironing("ironing3d");
     check("mu 0.3", &masters, &PINS_COULOMB);
     // the cubic B-spline master: V and H ripple at most 1/5 of the facets' (the
-    // issue's target; measured 0.16 and 0.12 — the quadratic one gives 0.31 and 0.34)
+    // issue's target; measured 0.16 and 0.13 — the quadratic one gives 0.31 and 0.35)
     let v_rms: Vec<f64> = masters.iter().map(|(_, h, _)| oscillation(&h.s, &h.v, ELEMENT, STEADY.0, STEADY.1).unwrap().rms).collect();
     let ripple: Vec<f64> = masters.iter().map(|(_, h, _)| h_ripple(h)).collect();
     assert!(v_rms[2] <= 0.2 * v_rms[0], "B-spline [4, 4] V oscillation {:.3e} vs facet {:.3e}", v_rms[2], v_rms[0]);
@@ -136,7 +136,7 @@ const PINS_FRICTIONLESS: [Pin; 3] = [
 ];
 
 const PINS_COULOMB: [Pin; 3] = [
-    Pin { master: "facet", v_rms: 1.28e-3, h_rms: 2.19e-3, newton: 366, cutbacks: 1 },
-    Pin { master: "b3", v_rms: 3.96e-4, h_rms: 7.38e-4, newton: 295, cutbacks: 1 },
+    Pin { master: "facet", v_rms: 1.28e-3, h_rms: 2.09e-3, newton: 342, cutbacks: 2 },
+    Pin { master: "b3", v_rms: 3.96e-4, h_rms: 7.38e-4, newton: 295, cutbacks: 2 },
     Pin { master: "b4", v_rms: 2.00e-4, h_rms: 2.65e-4, newton: 288, cutbacks: 0 },
 ];
