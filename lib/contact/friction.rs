@@ -220,17 +220,18 @@ fn evaluate(
         // Friction on a crease: the tangent vectors projected normal to n = d/g_N carry
         // the tangential traction (metric, return mapping, transfer), so the friction
         // force turns with n across the dead zone (docs/theory.md, "Friction on a crease")
-        let a_t = if crease && friction.mu > 0.0 { [0, 1].map(|al| sub(&a_al[al], &scale(&n, dot(&a_al[al], &n)))) } else { a_al };
+        let crease_friction = crease && friction.mu > 0.0;
+        let a_t = if crease_friction { [0, 1].map(|al| sub(&a_al[al], &scale(&n, dot(&a_al[al], &n)))) } else { a_al };
         let met = [[dot(&a_t[0], &a_t[0]), dot(&a_t[0], &a_t[1])], [dot(&a_t[1], &a_t[0]), dot(&a_t[1], &a_t[1])]];
         let met_inv = inv2(met).ok_or(ContactElementError::FocalPoint { g_n: g0 })?;
         let b = [[dot(&a_ab_v[0][0], &n), dot(&a_ab_v[0][1], &n)], [dot(&a_ab_v[1][0], &n), dot(&a_ab_v[1][1], &n)]];
         let mm = [[met[0][0] - g * b[0][0], met[0][1] - g * b[0][1]], [met[1][0] - g * b[1][0], met[1][1] - g * b[1][1]]];
-        let dm = inv_free(mm, sp.clamped).ok_or(ContactElementError::FocalPoint { g_n: g0 })?;
-        // On a crease the tangential traction is passed on through the unrestricted D
-        // (of the projected metric): at the zone's borders it is the facet's own D, so
-        // the friction force is continuous as the node enters and leaves the zone;
-        // ξ̄ itself moves only in the free directions.
-        let dt = if crease && friction.mu > 0.0 { inv2(mm).ok_or(ContactElementError::FocalPoint { g_n: g0 })? } else { dm };
+        // D, restricted to the free directions on a crease. With friction there the
+        // tangential traction is passed on through the unrestricted D (of the projected
+        // metric): at the zone's borders it is the facet's own D, so the friction force
+        // is continuous as the node enters and leaves the zone; ξ̄ itself moves only in
+        // the free directions.
+        let dt = if crease_friction { inv2(mm) } else { inv_free(mm, sp.clamped) }.ok_or(ContactElementError::FocalPoint { g_n: g0 })?;
         // normal law (eq. 4.2)
         let t_n = Dual::cst(normal.lambda_n) + g * normal.eps_n;
         // trial tangential traction and return mapping (eqs. 4.6–4.8)
@@ -457,13 +458,10 @@ mod tests {
     /// zone: a jump of μ|t_N| A_s = 30 at its borders.
     #[test]
     fn friction_force_is_continuous_across_a_crease_dead_zone() {
+        use crate::spline::facet::tests::valley_net;
         use crate::spline::{FacetProjector, FacetSurface};
-        let (na, nb) = (7, 3);
         // valley extruded along y (n̄ = +z), creases at x = 1 … 5; slopes 0.1 and 0.3 at x = 4
-        let x: Vec<Vec3> = (0..na * nb).map(|k| {
-            let (i, j) = ((k % na) as f64, (k / na) as f64);
-            Vec3::new(i, j, 0.1 * (i - 3.0).powi(2))
-        }).collect();
+        let (na, nb, x) = valley_net();
         let proj = FacetProjector::new(FacetSurface::new(na, nb).unwrap(), &x).unwrap();
         let normal = NormalLaw { lambda_n: 0.0, eps_n: 1e3, area: 1.0, touch: 0.0 };
         // stuck at x = 3.5 and moved on: the trial traction is far beyond μ|t_N| (slip, +x)

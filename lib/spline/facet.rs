@@ -357,10 +357,23 @@ impl FacetProjector {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::super::patch::tests::wavy_net;
     use super::super::BSplinePatch;
     use super::*;
+
+    /// A 7 × 3 valley net extruded along y (unit spacing, n̄ = +z): z = 0.1 (x − 3)²,
+    /// creases at x = 1 … 5; at x = 4 the slopes 0.1 and 0.3 meet (0.197 rad).
+    pub(crate) fn valley_net() -> (usize, usize, Vec<Vec3>) {
+        let (na, nb) = (7, 3);
+        let x = (0..na * nb)
+            .map(|k| {
+                let (i, j) = ((k % na) as f64, (k / na) as f64);
+                Vec3::new(i, j, 0.1 * (i - 3.0).powi(2))
+            })
+            .collect();
+        (na, nb, x)
+    }
 
     #[test]
     fn order_two_bspline_is_the_facet_set() {
@@ -450,11 +463,7 @@ mod tests {
     /// reaches the next facet's range.
     #[test]
     fn dead_zone_gap_is_continuous_with_crease_contact() {
-        let (na, nb) = (7, 3);
-        let x: Vec<Vec3> = (0..na * nb).map(|k| {
-            let (i, j) = ((k % na) as f64, (k / na) as f64);
-            Vec3::new(i, j, 0.1 * (i - 3.0).powi(2))
-        }).collect();
+        let (na, nb, x) = valley_net();
         let facets = FacetSurface::new(na, nb).unwrap();
         // the net is extruded along y and the points lie at y = 1 (ξ² = ½): brute force
         // over that line, spacing 1e-5 in x (distance error ≤ 1e-10 near the crease)
