@@ -125,7 +125,8 @@ fn shallow_ironing_coulomb_bspline() {
     assert!((0.30..=0.53).contains(&(h / v)), "{name}: H/V(1.5) = {} outside the published 0.30–0.53", h / v);
     // Steady sliding, every pressed node slides: Σ|T| = μ Σ|N| exactly (return
     // mapping); the vector sums differ from μ by the spread of the normals along the
-    // arc: measured 0.301–0.302, within 0.005 of μ. H/V adds the tilt of the normal
+    // arc: measured 0.3000 at t = 1.5 (the force on a slave is −A_s t_T; 0.301–0.302
+    // with the exact first variation of eq. 4.10, docs/theory.md), within 0.005 of μ. H/V adds the tilt of the normal
     // force on the indenter (the foundation piles up ahead of it): measured 0.306–0.320
     // over the travel [2, 5], within [0.3, 0.33].
     for (i, s) in r.s.iter().enumerate() {
@@ -150,7 +151,7 @@ struct Pin {
 }
 
 const PIN_FRICTIONLESS: Pin = Pin { v_15: 397.6, v_rms: 1.50e-4, newton: 1143, cutbacks: 0 };
-const PIN_COULOMB: Pin = Pin { v_15: 399.9, v_rms: 1.07e-4, newton: 1145, cutbacks: 0 };
+const PIN_COULOMB: Pin = Pin { v_15: 399.9, v_rms: 1.08e-4, newton: 1155, cutbacks: 0 };
 
 /// The facet master's chain of pipelines/shallow_ironing_frictionless.yaml (penalty,
 /// master-surface stabilisation `stabilization: 0.15`; without it the facet run
@@ -228,12 +229,12 @@ fn check_stabilization(results: &Results) {
 #[test]
 fn shallow_ironing_coulomb_facet_stabilized() {
     let name = "shallow_ironing";
-    // target ratio measured 0.020 (1.07e-4 against 5.37e-3)
+    // target ratio measured 0.021 (1.08e-4 against 5.05e-3)
     let (v, h, r) = solve_facet(name, &PIN_FACET_COULOMB, &PIN_COULOMB);
     assert!((0.30..=0.53).contains(&(h / v)), "{name}: H/V(1.5) = {} outside the published 0.30–0.53", h / v);
     // Every pressed node slides in steady sliding and the facets' normals are straight
     // lines in z: Σ|T| = μ Σ|N| to the return mapping's round-off (measured 0.3000 over
-    // the travel [2, 5]). H/V swings more than the B-spline master's (0.316–0.362:
+    // the travel [2, 5]). H/V swings more than the B-spline master's (0.306–0.344:
     // the snaps over the creases add resistance), so it is held to the published band.
     for (i, s) in r.s.iter().enumerate() {
         if (STEADY.0..=STEADY.1).contains(s) {
@@ -250,9 +251,10 @@ fn shallow_ironing_coulomb_facet_stabilized() {
 /// stabilisation's share of the load (docs/validation.md).
 const PIN_FACET_FRICTIONLESS: Pin = Pin { v_15: 371.50, v_rms: 3.87e-3, newton: 747, cutbacks: 0 };
 /// With μ = 0.3 (2026-11-23), tolerances as above: V(1.5) inside the published band,
-/// 6.6 % under the B-spline [2, 4] master's (399.9; the penalty and the stabilisation,
-/// as without friction).
-const PIN_FACET_COULOMB: Pin = Pin { v_15: 373.39, v_rms: 5.37e-3, newton: 893, cutbacks: 16 };
+/// 7.3 % under the B-spline [2, 4] master's (399.9; the penalty and the stabilisation,
+/// as without friction). Re-pinned with the friction transfer through the tangent
+/// plane (docs/theory.md; before: 373.39, 5.37e-3, 893 corrections, 16 cutbacks).
+const PIN_FACET_COULOMB: Pin = Pin { v_15: 370.67, v_rms: 5.05e-3, newton: 818, cutbacks: 12 };
 /// ‖f_stab‖ / ‖F_contact‖ over the sliding: measured at most 0.045 (at the slide's
 /// start, where the extrapolated pressing motion turns into sliding; ~0.02 after).
 const STAB_LIMIT: f64 = 0.07;
