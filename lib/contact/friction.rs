@@ -215,12 +215,6 @@ fn evaluate(
         let a_t = if crease_friction { [0, 1].map(|al| sub(&a_al[al], &scale(&n, dot(&a_al[al], &n)))) } else { a_al };
         let met = [[dot(&a_t[0], &a_t[0]), dot(&a_t[0], &a_t[1])], [dot(&a_t[1], &a_t[0]), dot(&a_t[1], &a_t[1])]];
         let met_inv = inv2(met).ok_or(ContactElementError::FocalPoint { g_n: g0 })?;
-        // Transfer of the tangential traction: δξ̄^α at g_N = 0, ā^{αβ} T_β (eq. 4.10
-        // without its g_N terms; docs/theory.md, "Friction: the transfer"), so the
-        // friction force on the slave is the traction vector −A_s t_T itself and stays
-        // continuous where the curvature b̄ jumps (the knots of an order-3 master). On a
-        // crease the metric is the projected one, the tangent normal to n = d/g_N.
-        let dt = met_inv;
         // normal law (eq. 4.2)
         let t_n = Dual::cst(normal.lambda_n) + g * normal.eps_n;
         // trial tangential traction and return mapping (eqs. 4.6–4.8)
@@ -236,6 +230,15 @@ fn evaluate(
         } else {
             tr
         };
+        // Transfer (docs/theory.md, "Friction: the transfer"): δξ̄^α = ā^{αβ} T_β, eq. 4.10
+        // at g_N = 0, so t_Tα δξ̄^α = t_T·(δx_s − Q_A δx_A) with the traction vector
+        // t_T = t_Tα ā^{αβ} ā_β: the friction force on the slave is −A_s t_T itself and
+        // stays continuous where the curvature b̄ jumps (the knots of an order-3
+        // master). On a crease the metric is the projected one, the tangent normal to n.
+        let t_vec: D3 = [0, 1, 2].map(|c| {
+            let up = [met_inv[0][0] * t_t[0] + met_inv[0][1] * t_t[1], met_inv[1][0] * t_t[0] + met_inv[1][1] * t_t[1]];
+            up[0] * a_t[0][c] + up[1] * a_t[1][c]
+        });
         // r = A (t_N N + t_Tα ā^{αβ} T_β), assembled per node block
         let area = normal.area;
         let mut put = |i: usize, v: Dual| {
@@ -247,30 +250,23 @@ fn evaluate(
                 r[i] = v.v * area;
             }
         };
-        // slave block: N_s = n̄, δξ̄^α/δx_s = ā^{αβ} ā_β
-        let dxi_s = [0, 1].map(|al| [0, 1, 2].map(|c| dt[al][0] * a_t[0][c] + dt[al][1] * a_t[1][c]));
+        // slave block: N_s = n̄, T_β,s = ā_β
         for c in 0..3 {
-            put(c, t_n * n[c] + t_t[0] * dxi_s[0][c] + t_t[1] * dxi_s[1][c]);
+            put(c, t_n * n[c] + t_vec[c]);
         }
+        // control point A: N_A = −Q_A n̄, T_β,A = −Q_A ā_β
         for (a, &q_a) in qd.iter().enumerate().take(nc) {
-            // N_A = −Q_A n̄; T_β,A = −Q_A ā_β; δξ̄^α/δx_A = ā^{αβ} T_β,A
-            let wa: [D3; 2] = [0, 1].map(|be| [0, 1, 2].map(|c| -q_a * a_t[be][c]));
             for c in 0..3 {
-                let dxi_a = [dt[0][0] * wa[0][c] + dt[0][1] * wa[1][c], dt[1][0] * wa[0][c] + dt[1][1] * wa[1][c]];
-                put(3 * (1 + a) + c, -t_n * q_a * n[c] + t_t[0] * dxi_a[0] + t_t[1] * dxi_a[1]);
+                put(3 * (1 + a) + c, -q_a * (t_n * n[c] + t_vec[c]));
             }
         }
         if j == m {
-            let tv: D3 = [0, 1, 2].map(|c| {
-                let up = [met_inv[0][0] * t_t[0] + met_inv[0][1] * t_t[1], met_inv[1][0] * t_t[0] + met_inv[1][1] * t_t[1]];
-                up[0] * a_t[0][c] + up[1] * a_t[1][c]
-            });
             state = Some(FrictionState {
                 g_n: g.v,
                 t_n: t_n.v,
                 active: true,
                 t_t: [t_t[0].v, t_t[1].v],
-                t_t_vector: Vec3::new(tv[0].v, tv[1].v, tv[2].v),
+                t_t_vector: Vec3::new(t_vec[0].v, t_vec[1].v, t_vec[2].v),
                 slip,
                 slave_force: Vec3::zeros(),
             });
