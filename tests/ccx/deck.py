@@ -274,6 +274,17 @@ def quad_area(x):
     return a
 
 
+def tributary_areas(faces, xyz, U=None):
+    """Node -> a quarter of the area of each adjacent face (ccx gencontelem_n2f:
+    areaslav / nodes per face); faces are node lists, taken at X + U."""
+    U, area = U or {}, {}
+    for fn in faces:
+        a = quad_area(np.array([xyz[n] + U.get(n, 0.0) for n in fn]))
+        for n in fn:
+            area[n] = area.get(n, 0.0) + a / 4
+    return area
+
+
 # --------------------------------------------------------------------- setup
 def lame(m):
     """(E, nu, mu, K) of a material entry given as E, nu or lambda, mu."""
@@ -763,24 +774,31 @@ def applied(model, set_name, t, U):
     return f
 
 
+def ccx_job(ccx, cwd, name):
+    """Run ccx on cwd/<name>.inp (OMP_NUM_THREADS=1 unless set).  Returns ok, rc, log,
+    wall (seconds), version and the .dat, .sta, .cvg texts ('' if absent)."""
+    env = dict(os.environ, OMP_NUM_THREADS=os.environ.get("OMP_NUM_THREADS", "1"))
+    t0 = time.perf_counter()
+    p = subprocess.run([ccx, "-i", name], cwd=cwd, env=env, capture_output=True, text=True)
+    wall = time.perf_counter() - t0
+    log = p.stdout + p.stderr
+    m = re.search(r"Version\s+([0-9][0-9.]*[0-9])", log)
+    rd = lambda ext: (cwd / (name + ext)).read_text() if (cwd / (name + ext)).exists() else ""
+    return dict(ok=p.returncode == 0 and "*ERROR" not in log and "Job finished" in log, rc=p.returncode,
+                log=log, wall=wall, version=m.group(1) if m else "?", dat=rd(".dat"), sta=rd(".sta"), cvg=rd(".cvg"))
+
+
 def run_ccx(deck, model, out, ccx):
     name = model["name"]
     out.mkdir(parents=True, exist_ok=True)
     for ext in (".dat", ".sta", ".cvg", ".frd"):
         (out / (name + ext)).unlink(missing_ok=True)
-    env = dict(os.environ, OMP_NUM_THREADS=os.environ.get("OMP_NUM_THREADS", "1"))
-    t0 = time.perf_counter()
-    p = subprocess.run([ccx, "-i", name], cwd=out, env=env, capture_output=True, text=True)
-    wall = time.perf_counter() - t0
-    log = p.stdout + p.stderr
+    job = ccx_job(ccx, out, name)
+    log, ok = job["log"], job["ok"]
     (out / (name + ".log")).write_text(log)
-    ok = p.returncode == 0 and "*ERROR" not in log and "Job finished" in log
-    rd = lambda ext: (out / (name + ext)).read_text() if (out / (name + ext)).exists() else ""
-    dat, sta, cvg = rd(".dat"), rd(".sta"), rd(".cvg")
-    blocks = parse_dat(dat)
-    m = re.search(r"Version\s+([0-9][0-9.]*[0-9])", log)
-    res = dict(pipeline=None, deck=shown(out / (name + ".inp")), ccx_version=m.group(1) if m else "?",
-               ok=ok, wall_seconds=round(wall, 3), notes=model["notes"])
+    blocks = parse_dat(job["dat"])
+    res = dict(pipeline=None, deck=shown(out / (name + ".inp")), ccx_version=job["version"],
+               ok=ok, wall_seconds=round(job["wall"], 3), notes=model["notes"])
     if not ok:
         err = [l for l in log.splitlines() if "ERROR" in l or "error" in l]
         res["error"] = err[-5:] or log.splitlines()[-5:]
@@ -792,7 +810,7 @@ def run_ccx(deck, model, out, ccx):
             mset = re.search(r"set\s+(\S+)", s)
             if mset and rows:
                 rf.setdefault(t, {})[mset.group(1).upper()] = rows[-1][-3:]
-    sta_rows = parse_sta(sta)
+    sta_rows = parse_sta(job["sta"])
 
     def reaction(total_rf, sn, t, U):
         # ccx RF is the internal nodal force: at a loaded free dof it equals the load.
@@ -823,7 +841,7 @@ def run_ccx(deck, model, out, ccx):
                                     for sname, sn in model["reaction_sets"]}))
     res["increments"] = incs
     res["target_factors"] = model["factors"]
-    res["cvg_iterations_total"] = len(parse_cvg(cvg))
+    res["cvg_iterations_total"] = len(parse_cvg(job["cvg"]))
     if disp:
         t, rows = disp[-1]
         U = {int(r[0]): np.array(r[1:4]) for r in rows}
@@ -850,11 +868,7 @@ def run_ccx(deck, model, out, ccx):
                     info.update(active=sum(1 for v in ps.values() if v > 0),
                                 max_pressure=max(ps.values()) if ps else 0.0)
                     if p["slave_faces"] is not None:
-                        area = {}
-                        for fn in p["slave_faces"]:
-                            a = quad_area(np.array([model["xyz"][n] + U.get(n, 0.0) for n in fn]))
-                            for n in fn:
-                                area[n] = area.get(n, 0.0) + a / 4
+                        area = tributary_areas(p["slave_faces"], model["xyz"], U)
                         # sum of p_i A_i with ccx's (deformed) tributary areas
                         info["normal_force_total"] = float(sum(v * area[n] for n, v in ps.items() if v > 0))
                 else:

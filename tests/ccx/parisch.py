@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """CalculiX (ccx) reference for the Parisch two-block contact example.
 
-Reads the committed gmsh mesh meshes/parisch.msh with meshio and writes a ccx
-deck (tests/ccx/parisch.inp by default).  With --run it runs ccx on the deck in
+Reads the committed gmsh mesh meshes/parisch.msh (with deck.py's reader) and writes
+a ccx deck (tests/ccx/parisch.inp by default).  With --run it runs ccx on the deck in
 a temporary directory and prints a JSON summary (load-node displacement, final
 z, total contact force, reactions, per-slave-node contact pressure, Newton
 iteration counts).  With --sweep it runs the penalty slopes 1e5 ... 1e9 and
@@ -23,23 +23,19 @@ penalty contact, slave = upper_bottom, master = lower_top, linear
 pressure-overclosure with slope K.
 """
 import argparse
-import contextlib
-import io
 import json
-import os
-import re
 import shutil
-import subprocess
 import sys
 import tempfile
 from pathlib import Path
 
-import meshio
 import numpy as np
 
-# the ccx face table, the (f20.0) float field, the number pattern and the .cvg
-# reader are the general deck generator's (this script is its Parisch special case)
-from deck import HEX_FACES, NUM, fmt, parse_cvg
+# this script is the Parisch special case of the general deck generator: mesh
+# reading, the float field, the id lines, running ccx, the .dat/.sta/.cvg readers
+# and the tributary areas are deck.py's
+from deck import (DEFAULT_TENSION, ccx_job, fmt, ids_lines, parse_cvg, parse_dat,
+                  parse_sta, read_mesh, tributary_areas)
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent.parent
@@ -49,10 +45,6 @@ DEFAULT_OUT = HERE / "parisch.inp"
 E_UPPER, E_LOWER, NU = 1.0e9, 1.0e10, 0.3
 DEFAULT_SLOPE = 1.0e5
 DEFAULT_FORCE = -2.0e6
-# ccx's sigma_inf: tension at large clearance; it also sets the width
-# eps = pi*sigma_inf/K of ccx's arctan regularisation of the linear law at g = 0.
-# The contact pressure is shifted by about -sigma_inf (relative 2e-10 here).
-DEFAULT_TENSION = 1.0e-6
 # ccx *CONTROLS, PARAMETERS=FIELD: R_n (residual / mean force) and C_n
 # (correction / increment).  ccx's round-off floor here is ~2e-9 relative;
 # 1e-8 is about as tight as it converges (1e-10 never converges).
@@ -61,77 +53,47 @@ SWEEP_SLOPES = [1e5, 1e6, 1e7, 1e8, 1e9]
 
 
 def neo_hooke(E, nu):
+    """(C10, D1).  Not deck.lame: its K = lambda + 2 mu / 3 rounds D1 differently,
+    and parisch.inp must not change."""
     mu = E / (2.0 * (1.0 + nu))
     K = E / (3.0 * (1.0 - 2.0 * nu))
-    return mu / 2.0, 2.0 / K  # C10, D1
-
-
-def cells_of(mesh, name, ctype):
-    """All cells of type ctype in physical group `name` (meshio cell_sets)."""
-    out = []
-    for block, idx in zip(mesh.cells, mesh.cell_sets[name]):
-        if block.type == ctype and idx is not None and len(idx):
-            out.append(block.data[np.asarray(idx)])
-    return np.concatenate(out) if out else np.zeros((0,), int)
-
-
-def hex_volume_sign(x):
-    """Sign of the Jacobian at the centre of an 8-node hex (x: 8x3)."""
-    d_xi = (x[1] + x[2] + x[5] + x[6] - x[0] - x[3] - x[4] - x[7]) / 4
-    d_et = (x[2] + x[3] + x[6] + x[7] - x[0] - x[1] - x[4] - x[5]) / 4
-    d_ze = (x[4] + x[5] + x[6] + x[7] - x[0] - x[1] - x[2] - x[3]) / 4
-    return np.sign(np.dot(np.cross(d_xi, d_et), d_ze))
+    return mu / 2.0, 2.0 / K
 
 
 def build_model(mesh_path=MESH):
-    with contextlib.redirect_stdout(io.StringIO()):  # meshio prints a blank line
-        mesh = meshio.read(str(mesh_path))
-    pts = np.asarray(mesh.points, float)
-    lower = cells_of(mesh, "lower", "hexahedron")
-    upper = cells_of(mesh, "upper", "hexahedron")
-    hexes = np.concatenate([lower, upper])  # ccx element ids 1..n, lower first
-    for h in hexes:
-        assert hex_volume_sign(pts[h]) > 0, "inverted hex"
-    elem_block = ["lower"] * len(lower) + ["upper"] * len(upper)
-
-    # element faces keyed by their node set
-    face_index = {}
-    for e, h in enumerate(hexes):
-        for f, loc in HEX_FACES.items():
-            key = frozenset(int(h[i - 1]) for i in loc)
-            face_index.setdefault(key, []).append((e + 1, f))
+    """deck.read_mesh's mesh with ccx elements 1..n, the lower block first."""
+    mesh = read_mesh(mesh_path)
+    assert not mesh["flipped"], "inverted hex"
+    body = {t: b for (t, _), b in zip(mesh["hexes"], mesh["hex_body"])}
+    hexes = [th for b in ("lower", "upper") for th in mesh["hexes"] if body[th[0]] == b]
+    eid = {t: k + 1 for k, (t, _) in enumerate(hexes)}
 
     def surface(name, block):
-        faces = []
-        for q in cells_of(mesh, name, "quad"):
-            hits = [ef for ef in face_index[frozenset(int(n) for n in q)]
-                    if elem_block[ef[0] - 1] == block]
-            assert len(hits) == 1, (name, q, hits)
-            faces.append(hits[0])
-        return sorted(faces)
+        """(element, face, face nodes), sorted; every face on the block's elements."""
+        faces = mesh["face_sets"][name]
+        assert all(body[t] == block for t, _, _ in faces), name
+        return sorted((eid[t], f, fn) for t, f, fn in faces)
 
-    def nodes(name, ctype):
-        c = cells_of(mesh, name, ctype)
-        return sorted({int(n) + 1 for n in np.ravel(c)})
-
+    sets = mesh["node_sets"]
     model = dict(
-        points=pts,
-        hexes=hexes + 1,
-        n_lower=len(lower),
+        xyz=mesh["xyz"],
+        nodes=mesh["used"],
+        hexes=[h for _, h in hexes],
+        n_lower=mesh["hex_body"].count("lower"),
         master=surface("lower_top", "lower"),
         slave=surface("upper_bottom", "upper"),
-        base=nodes("lower_base", "quad"),
-        slave_nodes=nodes("upper_bottom", "quad"),
-        load=nodes("load_node", "vertex"),
-        axis=nodes("upper_axis", "vertex"),
-        twist=nodes("upper_twist", "vertex"),
+        base=sets["lower_base"],
+        slave_nodes=sets["upper_bottom"],
+        load=sets["load_node"],
+        axis=sets["upper_axis"],
+        twist=sets["upper_twist"],
     )
     assert len(model["load"]) == 1 and len(model["axis"]) == 2 and len(model["twist"]) == 1
     return model
 
 
 def write_deck(model, path, slope, force, tension, ran=DEFAULT_RAN):
-    pts, hexes, nl = model["points"], model["hexes"], model["n_lower"]
+    xyz, hexes, nl = model["xyz"], model["hexes"], model["n_lower"]
     c10u, d1u = neo_hooke(E_UPPER, NU)
     c10l, d1l = neo_hooke(E_LOWER, NU)
     L = []
@@ -144,23 +106,21 @@ def write_deck(model, path, slope, force, tension, ran=DEFAULT_RAN):
     w("*HEADING")
     w("Parisch two-block contact (splinecontact reference)")
     w("*NODE, NSET=NALL")
-    for i, p in enumerate(pts):
-        w("%d, %s, %s, %s" % (i + 1, fmt(p[0]), fmt(p[1]), fmt(p[2])))
+    for n in model["nodes"]:
+        w("%d, %s, %s, %s" % (n, fmt(xyz[n][0]), fmt(xyz[n][1]), fmt(xyz[n][2])))
     for name, rng in (("ELOWER", range(0, nl)), ("EUPPER", range(nl, len(hexes)))):
         w("*ELEMENT, TYPE=C3D8, ELSET=%s" % name)
         for e in rng:
-            w("%d, %s" % (e + 1, ", ".join(str(int(n)) for n in hexes[e])))
+            w("%d, %s" % (e + 1, ", ".join(str(n) for n in hexes[e])))
     for name, key in (("NBASE", "base"), ("NLOAD", "load"), ("NAXIS", "axis"),
                       ("NTWIST", "twist"), ("NSLAVE", "slave_nodes")):
         w("*NSET, NSET=%s" % name)
-        ids = model[key]
-        for k in range(0, len(ids), 8):
-            w(", ".join(str(n) for n in ids[k:k + 8]))
+        L.extend(ids_lines(model[key]))
     w("*SURFACE, NAME=SMASTER, TYPE=ELEMENT")
-    for e, f in model["master"]:
+    for e, f, _ in model["master"]:
         w("%d, S%d" % (e, f))
     w("*SURFACE, NAME=SSLAVE, TYPE=ELEMENT")
-    for e, f in model["slave"]:
+    for e, f, _ in model["slave"]:
         w("%d, S%d" % (e, f))
     w("** C10 = mu/2, D1 = 2/K; E = %s (lower), %s (upper), nu = %s" % (fmt(E_LOWER), fmt(E_UPPER), fmt(NU)))
     w("*MATERIAL, NAME=MLOWER")
@@ -203,110 +163,42 @@ def write_deck(model, path, slope, force, tension, ran=DEFAULT_RAN):
     Path(path).write_text("\n".join(L) + "\n")
 
 
-# ---------------------------------------------------------------- .dat parsing
-
-
-def parse_dat(text):
-    """Blocks of a ccx .dat: {header line: [rows of floats]}.  Every text line
-    starts a new block; a header with a time stamp names the result set, other
-    text lines (e.g. under contact statistics) get it as prefix."""
-    blocks, cur, main = {}, None, ""
-    for line in text.splitlines():
-        s = line.strip()
-        if not s:
-            continue
-        if re.fullmatch(r"(%s\s*)+" % NUM, s):
-            if cur is not None:
-                blocks[cur].append([float(t.replace("D", "E")) for t in s.split()])
-            continue
-        if " time " in s:
-            main = s
-            cur = s
-        else:
-            cur = main + " / " + s
-        blocks[cur] = []
-    return blocks
-
-
-def find(blocks, *words):
-    hits = [k for k in blocks if all(wd.lower() in k.lower() for wd in words)]
-    return blocks[hits[-1]] if hits else None
-
-
-def parse_sta(text):
-    """(increments, total iterations, per-increment iterations) from .sta."""
-    incs, iters = 0, []
-    for line in text.splitlines():
-        t = line.split()
-        if len(t) >= 7 and t[0].isdigit() and t[1].isdigit():
-            incs += 1
-            iters.append(int(t[3]))
-    return incs, iters
-
-
-def slave_areas(model, disp=None):
-    """Tributary area of each slave node: a quarter of each adjacent slave face
-    (ccx gencontelem_n2f: areaslav/number of face nodes), with the faces in the
-    configuration X + disp (ccx evaluates them in the current configuration)."""
-    pts, hexes = model["points"], model["hexes"]
-    area = {}
-    for e, f in model["slave"]:
-        ids = [int(hexes[e - 1][i - 1]) for i in HEX_FACES[f]]
-        x = np.array([pts[n - 1] + (disp[n] if disp else 0.0) for n in ids])
-        # bilinear quad area, 2x2 Gauss
-        a = 0.0
-        g = 1.0 / np.sqrt(3.0)
-        for xi in (-g, g):
-            for et in (-g, g):
-                dxi = 0.25 * (-(1 - et) * x[0] + (1 - et) * x[1] + (1 + et) * x[2] - (1 + et) * x[3])
-                det = 0.25 * (-(1 - xi) * x[0] - (1 + xi) * x[1] + (1 + xi) * x[2] + (1 - xi) * x[3])
-                a += np.linalg.norm(np.cross(dxi, det))
-        for n in ids:
-            area[n] = area.get(n, 0.0) + a / 4.0
-    return area
+def rows(blocks, *words):
+    """Rows of the last .dat block whose title holds all the words."""
+    hits = [r for title, _, r in blocks if all(wd.lower() in title.lower() for wd in words)]
+    return hits[-1] if hits else None
 
 
 def run_ccx(model, slope, force, tension, ccx="ccx", keep=None, ran=DEFAULT_RAN):
+    """Run ccx on the deck in a temporary directory: (JSON summary, .dat text)."""
     work = Path(tempfile.mkdtemp(prefix="parisch_ccx_"))
-    failed = False
-    try:
-        job = work / "parisch"
-        write_deck(model, str(job) + ".inp", slope, force, tension, ran)
-        env = dict(os.environ, OMP_NUM_THREADS=os.environ.get("OMP_NUM_THREADS", "1"))
-        p = subprocess.run([ccx, "-i", "parisch"], cwd=work, env=env,
-                           capture_output=True, text=True)
-        log = p.stdout + p.stderr
-        if p.returncode != 0 or "*ERROR" in log or "Job finished" not in log:
-            sys.stderr.write(log[-4000:])
-            failed = True
-            raise RuntimeError("ccx failed (rc=%d), see %s" % (p.returncode, work))
-        dat = (work / "parisch.dat").read_text()
-        sta = (work / "parisch.sta").read_text() if (work / "parisch.sta").exists() else ""
-        cvg = (work / "parisch.cvg").read_text() if (work / "parisch.cvg").exists() else ""
-        if keep:
-            shutil.copytree(work, keep, dirs_exist_ok=True)
-    finally:
-        if not keep and not failed:
-            shutil.rmtree(work, ignore_errors=True)
+    write_deck(model, work / "parisch.inp", slope, force, tension, ran)
+    job = ccx_job(ccx, work, "parisch")
+    if not job["ok"]:
+        sys.stderr.write(job["log"][-4000:])
+        raise RuntimeError("ccx failed (rc=%d), see %s" % (job["rc"], work))
+    if keep:
+        shutil.copytree(work, keep, dirs_exist_ok=True)
+    else:
+        shutil.rmtree(work, ignore_errors=True)
 
-    b = parse_dat(dat)
+    b = parse_dat(job["dat"])
     (load_id,) = model["load"]
-    u_load = [r for r in find(b, "displacements", "NLOAD") if int(r[0]) == load_id][0][1:4]
-    z0 = float(model["points"][load_id - 1][2])
-    base_tot = find(b, "total force", "NBASE")
-    slave_u = {int(r[0]): np.array(r[1:4]) for r in find(b, "displacements", "NSLAVE")}
+    u_load = [r for r in rows(b, "displacements", "NLOAD") if int(r[0]) == load_id][0][1:4]
+    z0 = float(model["xyz"][load_id][2])
+    base_tot = rows(b, "total force", "NBASE")
+    slave_u = {int(r[0]): np.array(r[1:4]) for r in rows(b, "displacements", "NSLAVE")}
     # RF in ccx is the internal nodal force: at an unconstrained dof it equals
     # the applied load (node 20, z), at a constrained dof it is the reaction.
-    axis = {int(r[0]): r[1:3] for r in find(b, "forces", "NAXIS")}
-    twist = {int(r[0]): r[1:2] for r in find(b, "forces", "NTWIST")}
-    press = {int(r[0]): r[1] for r in find(b, "contact stress")}
-    a_cur = slave_areas(model, slave_u)
-    a_ref = slave_areas(model)
-    incs, iters = parse_sta(sta)
-    cvg_rows = parse_cvg(cvg)
-    m = re.search(r"Version\s+([0-9][0-9.]*[0-9])", log)
+    axis = {int(r[0]): r[1:3] for r in rows(b, "forces", "NAXIS")}
+    twist = {int(r[0]): r[1:2] for r in rows(b, "forces", "NTWIST")}
+    press = {int(r[0]): r[1] for r in rows(b, "contact stress")}
+    slave_faces = [fn for _, _, fn in model["slave"]]
+    a_cur = tributary_areas(slave_faces, model["xyz"], slave_u)
+    a_ref = tributary_areas(slave_faces, model["xyz"])
+    sta = parse_sta(job["sta"])
     res = dict(
-        ccx_version=m.group(1) if m else "?",
+        ccx_version=job["version"],
         slope=slope, force=force, tension=tension, field_ran=ran,
         load_node=dict(id=load_id, ux=u_load[0], uy=u_load[1], uz=u_load[2], z=z0 + u_load[2]),
         # sum of p_i * A_i, A_i from the deformed slave faces (what ccx uses)
@@ -318,11 +210,11 @@ def run_ccx(model, slope, force, tension, ccx="ccx", keep=None, ran=DEFAULT_RAN)
         twist_reaction_x={n: v[0] for n, v in twist.items()},
         slave_pressure={n: press[n] for n in sorted(press)},
         slave_uz={n: float(v[2]) for n, v in sorted(slave_u.items())},
-        increments=incs, iterations_per_increment=iters,
+        increments=len(sta), iterations_per_increment=[r["iterations"] for r in sta],
         cvg=[dict(inc=int(r[1]), att=int(r[2]), it=int(r[3]), contel=int(r[4]),
-                  resid_pct=r[5], corr_pct=r[6]) for r in cvg_rows],
+                  resid_pct=r[5], corr_pct=r[6]) for r in parse_cvg(job["cvg"])],
     )
-    return res, dat
+    return res, job["dat"]
 
 
 def main(argv=None):
