@@ -1,4 +1,4 @@
-//! sc-solve: finite-strain static solve of a hex8 mesh, with frictionless contact.
+//! sc-solve: finite-strain static solve of a hex8 mesh, with frictional contact.
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -9,8 +9,9 @@ use splinecontact::stages::solve;
 
 /// Solve a finite-strain static problem on a .scmesh, or a contact problem on the
 /// .sccontact written by sc-tag: neo-Hookean (Ciarlet–Simo or deviatoric/volumetric)
-/// or linear elastic bodies of 8-node hexahedra, node-to-surface frictionless contact
-/// against a B-spline or facet master (penalty or augmented Lagrangian), load
+/// or linear elastic bodies of 8-node hexahedra, node-to-surface contact, with
+/// Coulomb friction or without, against a B-spline or facet master (penalty or
+/// augmented Lagrangian), load
 /// increments with Newton–Raphson, cut back when an increment fails.
 ///
 /// The setup YAML gives a material per body, constraints and loads on the mesh's
@@ -42,6 +43,8 @@ use splinecontact::stages::solve;
 ///   sc-export block.scres -o block.pvd          # then: paraview block.pvd
 ///   sc-tag two.scmesh --pair contact:top_slave:bottom_master:bspline:3:3 -o two.sccontact
 ///   sc-solve two.sccontact --setup contact.yaml -o two.scres
+///   sc-solve two.sccontact --setup longer.yaml -o two.scres --restart two.scres
+///                                              # continue a stopped or finished run
 #[derive(Parser)]
 #[command(version, about, long_about, verbatim_doc_comment)]
 struct Args {
@@ -56,6 +59,12 @@ struct Args {
     /// Convergence history CSV (default: <output>.convergence.csv).
     #[arg(long)]
     csv: Option<PathBuf>,
+    /// Continue the run in this results file (.scres, of the same model) from its
+    /// last converged increment: displacements, contact multipliers and friction
+    /// history are taken from it, the increments it reached are skipped, and the
+    /// output starts with its increments. It may be the output file itself.
+    #[arg(long, value_name = "SCRES")]
+    restart: Option<PathBuf>,
     /// Print nothing but errors.
     #[arg(short, long)]
     quiet: bool,
@@ -72,7 +81,7 @@ fn main() -> ExitCode {
     };
     let csv = args.csv.clone().or_else(|| solve::default_csv_path(&args.output));
     let verbosity = if args.quiet { Verbosity::Quiet } else { Verbosity::Normal };
-    match solve::solve(&args.input, &setup, &args.setup.display().to_string(), &args.output, csv.as_deref(), verbosity) {
+    match solve::solve(&args.input, &setup, &args.setup.display().to_string(), &args.output, csv.as_deref(), args.restart.as_deref(), verbosity) {
         Ok(r) => {
             if !args.quiet {
                 eprintln!(

@@ -88,7 +88,8 @@ pub fn run(path: &Path, verbosity: Verbosity, log: &mut dyn FnMut(&str)) -> Resu
                     }
                 };
                 let csv = s.csv.as_ref().map(|c| resolve(&base, c)).or_else(|| stages::solve::default_csv_path(&out));
-                let r = stages::solve::solve(&input, &setup, &setup_name, &out, csv.as_deref(), verbosity).map_err(fail)?;
+                let restart = s.restart.as_ref().map(|r| resolve(&base, r));
+                let r = stages::solve::solve(&input, &setup, &setup_name, &out, csv.as_deref(), restart.as_deref(), verbosity).map_err(fail)?;
                 log(&format!("      {} increments, {} Newton iterations, {} cutbacks, {:.2} s", r.increments, r.iterations, r.cutbacks, r.seconds));
             }
             Stage::Export(s) => {

@@ -67,6 +67,22 @@ impl NodeGroups {
         self.offsets.push(self.nodes.len());
     }
 
+    /// Appends one group from an iterator (no intermediate list).
+    pub fn push_iter(&mut self, nodes: impl IntoIterator<Item = u32>) {
+        if self.offsets.is_empty() {
+            self.offsets.push(0);
+        }
+        self.nodes.extend(nodes);
+        self.offsets.push(self.nodes.len());
+    }
+
+    /// Removes every group, keeping the storage (rebuilt every Newton iteration).
+    pub fn clear(&mut self) {
+        self.offsets.clear();
+        self.offsets.push(0);
+        self.nodes.clear();
+    }
+
     pub fn len(&self) -> usize {
         self.offsets.len().saturating_sub(1)
     }
@@ -450,6 +466,26 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// A cleared list refilled (as the contact search does every iteration) equals
+    /// one built afresh, whether groups come as slices or iterators, and a taken
+    /// (empty, default) list can be refilled too.
+    #[test]
+    fn node_groups_refill_equals_a_fresh_list() {
+        let fresh: NodeGroups = [&[3u32, 35, 28][..], &[5, 30][..]].into_iter().collect();
+        let mut g: NodeGroups = [&[1u32, 2, 3, 4][..]].into_iter().collect();
+        g.clear();
+        g.push_iter(std::iter::once(3).chain([35, 28]));
+        g.push(&[5, 30]);
+        assert_eq!(g, fresh);
+        let mut taken = std::mem::take(&mut g);
+        assert!(g.is_empty());
+        g.push_iter([3, 35, 28]);
+        g.push_iter([5, 30]);
+        assert_eq!(g, fresh);
+        taken.clear();
+        assert_eq!((taken.len(), taken, g.group(1)), (0, NodeGroups::new(), &[5u32, 30][..]));
     }
 
     #[test]

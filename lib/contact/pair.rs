@@ -365,15 +365,11 @@ impl PairSolver {
     /// Appends the node group of every slave that needs a contact element now, and
     /// its slave index to `owners`.
     pub fn push_groups(&self, groups: &mut crate::assembly::NodeGroups, owners: &mut Vec<usize>) {
-        let mut nodes = Vec::with_capacity(1 + crate::spline::MAX_NODES);
         for s in 0..self.slaves.len() {
             if !self.usable(s) || (self.projections[s].g >= self.capture && self.lambda_n[s] >= 0.0) {
                 continue;
             }
-            nodes.clear();
-            nodes.push(self.slaves[s]);
-            nodes.extend(self.points[s].basis.nodes().iter().map(|&k| self.net[k]));
-            groups.push(&nodes);
+            groups.push_iter(std::iter::once(self.slaves[s]).chain(self.points[s].basis.nodes().iter().map(|&k| self.net[k])));
             owners.push(s);
         }
     }
@@ -571,6 +567,30 @@ impl PairSolver {
         }
         self.xi_n_committed.copy_from_slice(&self.xi_n);
         self.t_t_n_committed.copy_from_slice(&self.t_t_n);
+    }
+
+    /// A restart: the converged history of an increment as a results file stores it
+    /// (`state` rows [`CONTACT_STATE_COLUMNS`], `friction` rows [`FRICTION_COLUMNS`],
+    /// empty when the run had no friction), taken as [`Self::commit`] would have left
+    /// it: λ_N, the foot point ξ̄_n (none off the patch) and t_{Tα,n} of the active
+    /// nodes (eq. 4.7). The caller checked that the rows are this pair's slaves.
+    ///
+    /// [`CONTACT_STATE_COLUMNS`]: crate::format::scres::CONTACT_STATE_COLUMNS
+    /// [`FRICTION_COLUMNS`]: crate::format::scres::FRICTION_COLUMNS
+    pub fn restore_history(&mut self, state: &[[f64; 6]], friction: &[[f64; 9]]) {
+        for (s, row) in state.iter().enumerate().take(self.slaves.len()) {
+            let active = row[3] == SlaveStatus::Active.code();
+            self.lambda_n[s] = row[2];
+            self.xi_n[s] = if row[3] == SlaveStatus::Outside.code() { [f64::NAN; 2] } else { [row[4], row[5]] };
+            self.t_t_n[s] = match friction.get(s) {
+                Some(f) if active => [f[6], f[7]],
+                _ => [0.0; 2],
+            };
+        }
+        self.lambda_committed.copy_from_slice(&self.lambda_n);
+        self.xi_n_committed.copy_from_slice(&self.xi_n);
+        self.t_t_n_committed.copy_from_slice(&self.t_t_n);
+        self.augmentations = 0;
     }
 
     /// The increment failed: back to the last converged multipliers.

@@ -114,6 +114,10 @@ pub struct SolveStage {
     /// Convergence history CSV (default: beside the output).
     #[serde(default)]
     pub csv: Option<PathBuf>,
+    /// Continue the run in this results file from its last converged increment
+    /// (`sc-solve --restart`).
+    #[serde(default)]
+    pub restart: Option<PathBuf>,
 }
 
 #[derive(Debug, Deserialize)]

@@ -1,4 +1,4 @@
-//! The results stage file, `.scres` (format `scres`, version 1.0): the mesh, the
+//! The results stage file, `.scres` (format `scres`, version 1.3): the mesh, the
 //! setup that produced it, and the full state of every converged increment
 //! (displacements, Cauchy stress at the Gauss points, reactions, convergence
 //! history), so that a run can be inspected, exported or restarted from it.
@@ -19,7 +19,8 @@ pub const FORMAT: &str = "scres";
 pub const MAJOR: u32 = 1;
 /// 1.1: contact pairs and per-increment contact state (files without them read as
 /// 1.0 did). 1.2: `stabilization_force` in a pair's increment summary (absent when 0).
-pub const MINOR: u32 = 2;
+/// 1.3: `restart`, the results file a restarted run continued (absent otherwise).
+pub const MINOR: u32 = 3;
 
 /// One Newton iteration, as logged.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
@@ -149,6 +150,16 @@ pub struct Increment {
     pub friction: Vec<Vec<[f64; 9]>>,
 }
 
+/// Where a restarted run came from (1.3): its first `increments` increments are those
+/// of `file`, the last at `load_factor`.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct RestartOrigin {
+    pub file: String,
+    pub increments: u32,
+    pub load_factor: f64,
+}
+
 #[derive(Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct ResultsMeta {
@@ -161,6 +172,8 @@ struct ResultsMeta {
     increments: Vec<IncrementInfo>,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pairs: Vec<PairMeta>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    restart: Option<RestartOrigin>,
 }
 
 /// A results file in memory.
@@ -173,6 +186,8 @@ pub struct Results {
     pub increments: Vec<Increment>,
     /// The contact pairs of the model (empty without contact).
     pub pairs: Vec<ContactPair>,
+    /// A restarted run: the file it continued.
+    pub restart: Option<RestartOrigin>,
 }
 
 impl Results {
@@ -184,6 +199,7 @@ impl Results {
             setup: self.setup.clone(),
             increments: self.increments.iter().map(|i| i.info.clone()).collect(),
             pairs: self.pairs.iter().map(sccontact::pair_meta).collect(),
+            restart: self.restart.clone(),
         };
         w.meta(&serde_yaml::to_string(&meta).expect("results metadata serialises"));
         w.meta(&scmesh::mesh_meta_yaml(&self.mesh, &self.source));
@@ -259,7 +275,7 @@ impl Results {
             }
             increments.push(Increment { info, u: u.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(), stress, contact, friction });
         }
-        Ok(Self { mesh, source: meta.source, setup: meta.setup, status: meta.status, increments, pairs })
+        Ok(Self { mesh, source: meta.source, setup: meta.setup, status: meta.status, increments, pairs, restart: meta.restart })
     }
 
     pub fn read(path: &Path) -> Result<Self, StageError> {

@@ -17,6 +17,7 @@ use crate::format::sccontact::MasterKind;
 use crate::format::scres::{FrictionSummary, PairSummary};
 use crate::format::setup::Enforcement;
 use super::problem::Problem;
+use super::restart::RestartPoint;
 use crate::assembly::DOFS_PER_NODE;
 use crate::fem::element::hex8_min_jacobian;
 use crate::format::scres::{Increment, IncrementInfo, Reaction, Results, RunStatus};
@@ -41,6 +42,8 @@ pub enum SolveError {
     },
     #[error(transparent)]
     Write(#[from] StageError),
+    #[error("{file}: resuming from its last increment (load factor {load_factor:.6}): {failure}")]
+    Resume { file: String, load_factor: f64, failure: IncrementFailure },
 }
 
 /// What a finished solve reports.
@@ -194,11 +197,19 @@ fn contact_results(newton: &Newton, u: &[f64]) -> ContactResults {
 }
 
 /// Run all increments; `results` holds the mesh and setup and receives the increments.
-pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &mut Results, out: &Outputs, log: &mut SolveLog) -> Result<SolveSummary, SolveError> {
+/// With a restart point (whose increments `results` already holds) the solve continues
+/// from its last increment, with the load factors above it.
+pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &mut Results, out: &Outputs, log: &mut SolveLog, start: Option<&RestartPoint>) -> Result<SolveSummary, SolveError> {
     let p: &Problem = newton.problem;
-    let mut u = vec![0.0; DOFS_PER_NODE * p.n_nodes()];
+    let (mut u, mut lambda_prev) = match start {
+        Some(point) => {
+            newton.resume(point).map_err(|failure| SolveError::Resume { file: point.file.display().to_string(), load_factor: point.load_factor(), failure })?;
+            (point.u(point.increments.len() - 1), point.load_factor())
+        }
+        None => (vec![0.0; DOFS_PER_NODE * p.n_nodes()], 0.0),
+    };
+    let first = factors.len() - start.map_or(factors.len(), |point| point.remaining(factors));
     let mut trial = u.clone();
-    let mut lambda_prev = 0.0;
     let mut summary = SolveSummary { increments: 0, iterations: 0, cutbacks: 0 };
     let write = |results: &Results, log: &SolveLog| -> Result<(), StageError> {
         results.write(out.results)?;
@@ -211,7 +222,7 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
         Ok(())
     };
     let n_inc = factors.len();
-    for (k, &target) in factors.iter().enumerate() {
+    for (k, &target) in factors.iter().enumerate().skip(first) {
         let mut lambda = target;
         let mut failures = 0u32;
         let mut cutbacks_this = 0u32;

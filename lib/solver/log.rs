@@ -6,6 +6,8 @@ use std::io::{IsTerminal, Write};
 
 use indicatif::{ProgressBar, ProgressStyle};
 
+use crate::format::scres::IncrementInfo;
+
 /// How much to print.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Verbosity {
@@ -66,21 +68,7 @@ impl SolveLog {
     }
 
     pub fn iteration(&mut self, e: &IterationEvent) {
-        self.csv.push_str(&format!(
-            "{},{:e},{},{},{},{:e},{:e},{},{:.6},{:.6},{:.6},{:.6}\n",
-            e.increment,
-            e.load_factor,
-            e.attempt,
-            e.augmentation,
-            e.iteration,
-            e.residual,
-            e.energy,
-            e.contact_active,
-            e.seconds_contact,
-            e.seconds_assembly,
-            e.seconds_factor,
-            e.seconds_solve
-        ));
+        self.push_csv(e);
         let text = format!(
             "increment {}/{} (λ = {:.4}{}{}) iteration {:>2}: residual {:.3e}, energy {:.3e}{}",
             e.increment,
@@ -99,6 +87,32 @@ impl SolveLog {
         }
     }
 
+    /// The iterations of an increment read back from a results file (a restart):
+    /// its converged attempt, numbered `increment` of the load path; the attempts cut
+    /// back before it are not in the file. Only the CSV gets them.
+    pub fn restored(&mut self, increment: usize, n_increments: usize, info: &IncrementInfo) {
+        for row in &info.iterations {
+            self.push_csv(&IterationEvent {
+                increment,
+                n_increments,
+                load_factor: info.load_factor,
+                attempt: info.cutbacks,
+                iteration: row.iteration,
+                residual: row.residual,
+                energy: row.energy,
+                seconds_assembly: row.seconds_assembly,
+                seconds_factor: row.seconds_factor,
+                seconds_solve: row.seconds_solve,
+                seconds_contact: row.seconds_contact,
+                contact_active: row.contact_active,
+                augmentation: row.augmentation,
+            });
+        }
+        if let Some(b) = &self.bar {
+            b.set_position(increment as u64);
+        }
+    }
+
     pub fn increment_done(&self) {
         if let Some(b) = &self.bar {
             b.inc(1);
@@ -109,6 +123,24 @@ impl SolveLog {
         if let Some(b) = &self.bar {
             b.finish_and_clear();
         }
+    }
+
+    fn push_csv(&mut self, e: &IterationEvent) {
+        self.csv.push_str(&format!(
+            "{},{:e},{},{},{},{:e},{:e},{},{:.6},{:.6},{:.6},{:.6}\n",
+            e.increment,
+            e.load_factor,
+            e.attempt,
+            e.augmentation,
+            e.iteration,
+            e.residual,
+            e.energy,
+            e.contact_active,
+            e.seconds_contact,
+            e.seconds_assembly,
+            e.seconds_factor,
+            e.seconds_solve
+        ));
     }
 
     /// The convergence history so far, as CSV text.

@@ -2,7 +2,7 @@
 //! the static problem ([`problem`]) and its load curves ([`amplitude`]), Newton–Raphson for one increment ([`newton`]),
 //! the augmented Lagrangian's Uzawa loop ([`uzawa`]), the master-surface
 //! stabilisation ([`stabilization`]), load
-//! stepping with cutbacks ([`increments`]), what the user sees ([`log`]), and a
+//! stepping with cutbacks ([`increments`]), restarting from a results file ([`restart`]), what the user sees ([`log`]), and a
 //! timing benchmark on a clamped elastic cube ([`bench`]).
 
 pub mod amplitude;
@@ -12,6 +12,7 @@ pub mod linear;
 pub mod log;
 pub mod newton;
 pub mod problem;
+pub mod restart;
 pub mod stabilization;
 pub mod uzawa;
 

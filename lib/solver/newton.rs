@@ -16,6 +16,7 @@ use std::time::Instant;
 use nalgebra::{DMatrix, DVector, Vector3};
 
 use super::problem::Problem;
+use super::restart::RestartPoint;
 use super::stabilization::Stabilization;
 use crate::assembly::{Assembly, AssemblyError, ElementFailure, NodeGroups, Pattern, PatternError, DOFS_PER_NODE};
 use crate::contact::element::ContactElementError;
@@ -102,6 +103,10 @@ pub struct Newton<'p> {
     pub contact: Vec<PairSolver>,
     /// Owner of every group of `pattern`.
     owners: Vec<GroupOwner>,
+    /// The contact search's groups, compared with the pattern's every iteration
+    /// (storage reused), and the scratch list of a pair's slaves with a group.
+    group_scratch: NodeGroups,
+    slave_scratch: Vec<usize>,
     /// Times the pattern was rebuilt because contact groups changed.
     pub pattern_rebuilds: u32,
     /// The symmetry the linear solver was set up for.
@@ -128,8 +133,8 @@ impl<'p> Newton<'p> {
         for def in &problem.contact {
             contact.push(PairSolver::new(def, &problem.X)?);
         }
-        let mut owners = Vec::new();
-        let groups = contact_groups(problem, &mut contact, &vec![0.0; DOFS_PER_NODE * problem.n_nodes()], &mut owners)?;
+        let (mut owners, mut groups, mut slave_scratch) = (Vec::new(), NodeGroups::new(), Vec::new());
+        contact_groups(problem, &mut contact, &vec![0.0; DOFS_PER_NODE * problem.n_nodes()], &mut groups, &mut owners, &mut slave_scratch)?;
         for pair in &mut contact {
             pair.init_history();
         }
@@ -162,6 +167,8 @@ impl<'p> Newton<'p> {
             f_ext: vec![0.0; n],
             contact,
             owners,
+            group_scratch: NodeGroups::new(),
+            slave_scratch,
             pattern_rebuilds: 0,
             symmetry,
             step_halvings: 0,
@@ -178,8 +185,11 @@ impl<'p> Newton<'p> {
             return Ok(());
         }
         let fail = |message: String| IncrementFailure::ContactSetup { iteration, message };
-        let groups = contact_groups(self.problem, &mut self.contact, u, &mut self.owners).map_err(|e| fail(e.to_string()))?;
-        if &groups != self.pattern.groups() {
+        let mut groups = std::mem::take(&mut self.group_scratch);
+        contact_groups(self.problem, &mut self.contact, u, &mut groups, &mut self.owners, &mut self.slave_scratch).map_err(|e| fail(e.to_string()))?;
+        if &groups == self.pattern.groups() {
+            self.group_scratch = groups;
+        } else {
             self.pattern = self.pattern.with_groups(groups).map_err(|e| fail(e.to_string()))?;
             self.assembly = Assembly::new(&self.pattern).map_err(|e| fail(e.to_string()))?;
             self.linear.analyse(self.pattern.symbolic(), self.symmetry).map_err(|error| IncrementFailure::Linear { iteration, error })?;
@@ -223,6 +233,24 @@ impl<'p> Newton<'p> {
         if let Some(s) = &mut self.stabilization {
             s.commit(u, lambda);
         }
+    }
+
+    /// Continue from the converged increments of a results file: the stabilisation
+    /// takes the last two states (its extrapolation), every pair its multipliers and
+    /// friction history, and the contact search runs at the last state, so the next
+    /// increment starts where the interrupted run would have.
+    pub fn resume(&mut self, point: &RestartPoint) -> Result<(), IncrementFailure> {
+        let n = point.increments.len();
+        for k in n.saturating_sub(2)..n {
+            self.commit_increment(&point.u(k), point.increments[k].info.load_factor);
+        }
+        let last = point.last();
+        for (p, pair) in self.contact.iter_mut().enumerate() {
+            let state = last.contact.get(p).map_or(&[][..], |s| &s[..]);
+            let friction = last.friction.get(p).map_or(&[][..], |f| &f[..]);
+            pair.restore_history(state, friction);
+        }
+        self.contact_search(&point.u(n - 1), 0)
     }
 
     /// The stabilisation force ‖f‖ on each pair's master net at `u` (0 for a pair
@@ -517,23 +545,26 @@ enum AssemblyFailure {
     Contact(usize, usize, ContactElementError),
 }
 
-/// Contact search of every pair at `u` and the node groups of the pattern: the
-/// follower-pressure faces, then every contact element; `owners` says which is which.
-fn contact_groups(p: &Problem, contact: &mut [PairSolver], u: &[f64], owners: &mut Vec<GroupOwner>) -> Result<NodeGroups, PairError> {
-    let mut groups: NodeGroups = p.pressure_faces.iter().map(|f| &f.nodes[..]).collect();
+/// Contact search of every pair at `u` and the node groups of the pattern into
+/// `groups`: the follower-pressure faces, then every contact element; `owners` says
+/// which is which. (`slaves` is scratch; all three keep their storage between calls.)
+fn contact_groups(p: &Problem, contact: &mut [PairSolver], u: &[f64], groups: &mut NodeGroups, owners: &mut Vec<GroupOwner>, slaves: &mut Vec<usize>) -> Result<(), PairError> {
+    groups.clear();
+    for f in &p.pressure_faces {
+        groups.push(&f.nodes);
+    }
     owners.clear();
     owners.extend((0..p.pressure_faces.len()).map(GroupOwner::Pressure));
-    let mut slaves = Vec::new();
     for (k, pair) in contact.iter_mut().enumerate() {
         pair.search(|n| {
             let d = DOFS_PER_NODE * n as usize;
             p.X[n as usize] + Vector3::new(u[d], u[d + 1], u[d + 2])
         })?;
         slaves.clear();
-        pair.push_groups(&mut groups, &mut slaves);
+        pair.push_groups(groups, slaves);
         owners.extend(slaves.iter().map(|&s| GroupOwner::Contact(k, s)));
     }
-    Ok(groups)
+    Ok(())
 }
 
 /// Cauchy stress at the Gauss points of every element (row-major 3×3), in parallel.

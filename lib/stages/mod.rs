@@ -14,6 +14,7 @@ use crate::format::setup::SetupError;
 use crate::solver::increments::SolveError;
 use crate::solver::newton::SetupFailure;
 use crate::solver::problem::ProblemError;
+use crate::solver::restart::RestartError;
 use crate::format::stage::StageError;
 use crate::format::vtk::VtkError;
 use plot::PlotError;
@@ -47,6 +48,8 @@ pub enum StageRunError {
     #[error(transparent)]
     Solve(#[from] SolveError),
     #[error(transparent)]
+    Restart(#[from] RestartError),
+    #[error(transparent)]
     Tag(#[from] TagError),
     #[error(transparent)]
     Plot(#[from] PlotError),
@@ -64,6 +67,7 @@ impl StageRunError {
             | Self::Msh(MshError::Io { .. })
             | Self::Vtk(VtkError::Stage(StageError::Io { .. }))
             | Self::Solve(SolveError::Write(StageError::Io { .. }))
+            | Self::Restart(RestartError::Read(StageError::Io { .. }))
             | Self::Tool(_) => exit_code::IO,
             Self::Solve(SolveError::Diverged { .. }) => exit_code::DIVERGED,
             Self::Plot(e) => e.exit_code(),

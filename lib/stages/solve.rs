@@ -8,12 +8,13 @@ use super::StageRunError;
 use crate::format::sccontact::{self, ContactModel};
 use crate::format::scmesh;
 use crate::format::stage::StageFile;
-use crate::format::scres::{Results, RunStatus};
+use crate::format::scres::{RestartOrigin, Results, RunStatus};
 use crate::format::setup::SolveSetup;
 use crate::solver::increments::{self, Outputs};
 use crate::solver::log::{SolveLog, Verbosity};
 use crate::solver::newton::Newton;
 use crate::solver::problem::Problem;
+use crate::solver::restart::RestartPoint;
 
 /// What a finished solve reports.
 pub struct SolveReport {
@@ -30,8 +31,10 @@ pub fn default_csv_path(output: &Path) -> Option<std::path::PathBuf> {
 }
 
 /// Solve `setup` on the mesh in `input`, writing `output` after every converged
-/// increment and the convergence history to `csv`.
-pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, csv: Option<&Path>, verbosity: Verbosity) -> Result<SolveReport, StageRunError> {
+/// increment and the convergence history to `csv`; with `restart`, continue from the
+/// last increment of that results file (of the same model), whose increments then
+/// open `output` (which may be the same file: it is read before anything is written).
+pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, csv: Option<&Path>, restart: Option<&Path>, verbosity: Verbosity) -> Result<SolveReport, StageRunError> {
     if output.as_os_str() == "-" {
         return Err(StageRunError::Usage("sc-solve writes its results after every increment: give a file with -o, not -".into()));
     }
@@ -45,8 +48,19 @@ pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, 
         }
         other => return Err(StageRunError::Usage(format!("{}: a {other} file; sc-solve reads a mesh (.scmesh) or a contact model (.sccontact)", input.display()))),
     };
+    let point = restart.map(|file| RestartPoint::read(file, &mesh, &pairs)).transpose()?;
     let problem = Problem::with_contact(&mesh, &pairs, setup, setup_name)?;
     let factors = setup.load_factors(setup_name)?;
+    if let Some(point) = &point {
+        if point.remaining(&factors) == 0 {
+            return Err(StageRunError::Usage(format!(
+                "{}: the run already reached load factor {:.6}, and the setup {setup_name} ends at {:.6}: nothing left to solve (extend the load path to continue)",
+                point.file.display(),
+                point.load_factor(),
+                factors.last().copied().unwrap_or(0.0)
+            )));
+        }
+    }
     let mut newton = Newton::new(&problem, setup.newton.clone(), setup.linear_solver)?;
     let mut log = SolveLog::new(verbosity, factors.len());
     for (c, def) in newton.contact.iter().zip(&problem.contact) {
@@ -91,10 +105,29 @@ pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, 
         increments: Vec::new(),
         mesh,
         pairs,
+        restart: None,
     };
+    if let Some(point) = &point {
+        // the restart file's increments open the history, and its iterations the CSV
+        for inc in &point.increments {
+            let lambda = inc.info.load_factor;
+            let number = factors.iter().position(|&f| f >= lambda - 1e-12 * f.abs().max(1.0)).unwrap_or(factors.len() - 1) + 1;
+            log.restored(number, factors.len(), &inc.info);
+        }
+        results.increments = point.increments.clone();
+        results.restart = Some(RestartOrigin { file: point.file.display().to_string(), increments: point.increments.len() as u32, load_factor: point.load_factor() });
+        log.line(&format!(
+            "restart from {}: {} converged increments, continuing from load factor {:.6} ({} of the setup's {} increments left)",
+            point.file.display(),
+            point.increments.len(),
+            point.load_factor(),
+            point.remaining(&factors),
+            factors.len()
+        ));
+    }
     let forces = output.with_extension("forces.csv");
     let outputs = Outputs { results: output, csv, forces_csv: Some(&forces) };
-    let summary = increments::solve(&mut newton, &factors, setup.increments.max_cutbacks, &mut results, &outputs, &mut log);
+    let summary = increments::solve(&mut newton, &factors, setup.increments.max_cutbacks, &mut results, &outputs, &mut log, point.as_ref());
     if !newton.contact.is_empty() {
         log.line(&format!("contact: the sparsity pattern was rebuilt {} times as contact elements changed", newton.pattern_rebuilds));
     }

@@ -49,7 +49,7 @@ fn main() {
             let setup = SolveSetup::parse("bench", SETUP).expect("setup");
             let out = dir.path().join("r.scres");
             let t = Instant::now();
-            let report = solve(&input, &setup, "bench", &out, None, Verbosity::Quiet);
+            let report = solve(&input, &setup, "bench", &out, None, None, Verbosity::Quiet);
             let wall = t.elapsed().as_secs_f64();
             if let Err(e) = report {
                 println!("| {label} | {n} | solve failed: {e} |");

@@ -87,7 +87,7 @@ fn main() {
         drop(mesh);
 
         let t = Instant::now();
-        let report = solve(&mesh_path, &setup, "bench-setup", &out, None, Verbosity::Quiet);
+        let report = solve(&mesh_path, &setup, "bench-setup", &out, None, None, Verbosity::Quiet);
         let wall = t.elapsed().as_secs_f64();
         let results = Results::read(Path::new(&out)).expect("results file reads back");
         if let Err(e) = report {

@@ -94,3 +94,89 @@ fn cantilever_pipeline_results_open_in_meshio() {
     assert!(csv.starts_with("increment,load_factor,attempt,augmentation,iteration,residual,energy,contact_active,seconds_contact,seconds_assembly,seconds_factor,seconds_solve"));
     assert!(csv.lines().count() > 10);
 }
+
+/// `sc-solve --restart`: the stopped run above (increment 2 fails) continued with a
+/// gentler load path, into its own results file. The file then holds the first
+/// run's increment and the new ones and says where it was restarted from; the
+/// convergence CSV starts with the restored iterations. The cantilever is elastic,
+/// so the end state does not depend on the path: the tip deflection equals a direct
+/// run's to 1e-6 relative (both converge the residual to 1e-8).
+#[test]
+fn restart_continues_a_stopped_solve_into_its_own_file() {
+    use splinecontact::format::scres::{Results, RunStatus};
+    let dir = tempdir();
+    imported_cantilever(dir.path());
+    write_setup(dir.path(), &GOOD.replace("increments: {count: 5}", "increments: {factors: [0.01, 1.0], max_cutbacks: 0}\nnewton: {max_iterations: 3}"));
+    let o = run("sc-solve", &["c.scmesh", "--setup", "setup.yaml", "-o", "r.scres", "-q"], dir.path());
+    assert_eq!(o.status.code(), Some(3), "{}", stderr(&o));
+    write_setup(dir.path(), GOOD);
+    let o = run("sc-solve", &["c.scmesh", "--setup", "setup.yaml", "-o", "r.scres", "--restart", "r.scres"], dir.path());
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("restart from r.scres: 1 converged increments, continuing from load factor 0.010000 (5 of the setup's 5 increments left)"), "{err}");
+    let r = Results::read(&dir.path().join("r.scres")).unwrap();
+    assert_eq!(r.status, RunStatus::Completed);
+    let factors: Vec<f64> = r.increments.iter().map(|i| i.info.load_factor).collect();
+    assert_eq!(factors, [0.01, 0.2, 0.4, 0.6, 0.8, 1.0]);
+    assert_eq!(r.restart.as_ref().map(|o| (o.file.as_str(), o.increments, o.load_factor)), Some(("r.scres", 1, 0.01)));
+    let csv = std::fs::read_to_string(dir.path().join("r.convergence.csv")).unwrap();
+    assert!(csv.lines().nth(1).is_some_and(|l| l.starts_with("1,1e-2,0,0,0,")), "the restored iterations open the CSV:\n{csv}");
+    // the same setup from scratch
+    let o = run("sc-solve", &["c.scmesh", "--setup", "setup.yaml", "-o", "direct.scres", "-q"], dir.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let direct = Results::read(&dir.path().join("direct.scres")).unwrap();
+    let tip = |r: &Results| r.increments.last().unwrap().u.iter().map(|u| u[2]).fold(0.0f64, |m, v| m.max(v.abs()));
+    let (a, b) = (tip(&r), tip(&direct));
+    assert!((a - b).abs() <= 1e-6 * b, "restarted tip deflection {a}, direct {b}");
+    // nothing left: the finished run with the same setup
+    let o = run("sc-solve", &["c.scmesh", "--setup", "setup.yaml", "-o", "again.scres", "--restart", "r.scres"], dir.path());
+    assert_fails(&o, 2, &["r.scres", "already reached load factor 1.000000", "nothing left to solve"], &dir.path().join("again.scres"));
+}
+
+/// A restart file from another model, or not a results file: exit 2, the file named,
+/// nothing written.
+#[test]
+fn restart_from_another_model_is_refused() {
+    let dir = tempdir();
+    imported_cantilever(dir.path());
+    write_setup(dir.path(), GOOD);
+    let o = run("sc-solve", &["c.scmesh", "--setup", "setup.yaml", "-o", "r.scres", "-q"], dir.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = run("sc-import", &[repo().join("meshes/parisch.msh").to_str().unwrap(), "-o", "p.scmesh", "-q"], dir.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = run("sc-solve", &["p.scmesh", "--setup", "setup.yaml", "-o", "p.scres", "--restart", "r.scres"], dir.path());
+    assert_fails(&o, 2, &["r.scres: cannot restart from it: its mesh has", "the model has 50"], &dir.path().join("p.scres"));
+    let o = run("sc-solve", &["c.scmesh", "--setup", "setup.yaml", "-o", "x.scres", "--restart", "c.scmesh"], dir.path());
+    assert_fails(&o, 2, &["c.scmesh", "'scmesh' file, but a 'scres' file is expected"], &dir.path().join("x.scres"));
+}
+
+/// The pipeline's `restart:` key (resolved beside the pipeline like every path): the
+/// cantilever's pipeline continued to twice its load (`end: 2.0`), into a second
+/// results file that opens with the first run's five increments.
+#[test]
+fn pipeline_solve_stage_restarts() {
+    use splinecontact::format::scres::Results;
+    let dir = tempdir();
+    for sub in ["meshes", "pipelines"] {
+        std::fs::create_dir_all(dir.path().join(sub)).unwrap();
+    }
+    std::fs::copy(repo().join("meshes/cantilever.msh"), dir.path().join("meshes/cantilever.msh")).unwrap();
+    let first = std::fs::read_to_string(repo().join("pipelines/cantilever.yaml")).unwrap();
+    std::fs::write(dir.path().join("pipelines/cantilever.yaml"), &first).unwrap();
+    let o = run("sc-pipeline", &["pipelines/cantilever.yaml", "-q"], dir.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let more = first
+        .replace("increments: {count: 5, max_cutbacks: 5}", "increments: {count: 10, end: 2.0, max_cutbacks: 5}")
+        .replace("output: out/cantilever.scres ", "restart: out/cantilever.scres\n      output: out/longer.scres ")
+        .replace("input: out/cantilever.scres", "input: out/longer.scres")
+        .replace("output: out/cantilever.pvd", "output: out/longer.pvd");
+    assert!(more.contains("restart: out/cantilever.scres"), "{more}");
+    std::fs::write(dir.path().join("pipelines/longer.yaml"), &more).unwrap();
+    let o = run("sc-pipeline", &["pipelines/longer.yaml"], dir.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let r = Results::read(&dir.path().join("pipelines/out/longer.scres")).unwrap();
+    let factors: Vec<f64> = r.increments.iter().map(|i| i.info.load_factor).collect();
+    assert_eq!(factors.len(), 10, "{factors:?}");
+    assert!((factors[4] - 1.0).abs() < 1e-12 && (factors[9] - 2.0).abs() < 1e-12, "{factors:?}");
+    assert!(dir.path().join("pipelines/out/longer.pvd").is_file());
+}

@@ -21,7 +21,7 @@ pub fn run_contact(mesh: &Mesh, pairs: &[PairSpec], setup_yaml: &str) -> Results
     model.write(&c).unwrap();
     let setup = SolveSetup::parse("setup", setup_yaml).unwrap_or_else(|e| panic!("{e}"));
     let out = dir.path().join("r.scres");
-    let r = solve(&c, &setup, "setup", &out, None, Verbosity::Quiet);
+    let r = solve(&c, &setup, "setup", &out, None, None, Verbosity::Quiet);
     if let Err(e) = r {
         panic!("solve failed: {e}");
     }

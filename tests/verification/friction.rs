@@ -145,3 +145,118 @@ fn friction_fields_in_the_pvd() {
     let p_max = j["contact"]["slave_pressures"].as_sequence().unwrap().iter().map(|v| v.as_f64().unwrap()).fold(0.0, f64::max);
     assert!(t_max <= MU * p_max * (1.0 + 1e-6) && t_max > 0.9 * MU * p_max, "traction {t_max} vs μ p_max {}", MU * p_max);
 }
+
+/// Cut the run of `yaml` after increment `cut` (its results file truncated there,
+/// status stopped), continue it with `sc-solve --restart`, and continue it again
+/// after `forget` erased part of the stored history: (full, continued, forgetful).
+fn cut_and_continue(yaml: &str, cut: usize, forget: impl Fn(&mut splinecontact::format::scres::Increment)) -> [splinecontact::format::scres::Results; 3] {
+    use splinecontact::format::scres::{Results, RunStatus};
+    use splinecontact::format::setup::SolveSetup;
+    use splinecontact::solver::log::Verbosity;
+    use splinecontact::stages::solve::solve;
+    use splinecontact::stages::tag::build_model;
+
+    let mesh = two_bodies("lower", &block([2, 2, 1], [1.0, 1.0, 0.5], 0.0), "upper", &block([2, 2, 1], [0.5, 0.5, 0.25], 0.0), [0.25, 0.25, 0.5]);
+    let dir = crate::common::tempdir();
+    let model = build_model(mesh, "test", &[pair(MasterKind::Bspline, Some([3, 3]), "upper_z0", "lower_z1")]).unwrap();
+    let c = dir.path().join("m.sccontact");
+    model.write(&c).unwrap();
+    let s = SolveSetup::parse("setup", yaml).unwrap();
+    let run = |out: &str, restart: Option<&std::path::Path>| {
+        let out = dir.path().join(out);
+        if let Err(e) = solve(&c, &s, "setup", &out, None, restart, Verbosity::Quiet) {
+            panic!("{}: {e}", out.display());
+        }
+        let r = Results::read(&out).unwrap();
+        assert_eq!((r.status.clone(), r.increments.len()), (RunStatus::Completed, 40), "{}", out.display());
+        r
+    };
+    let full = run("full.scres", None);
+    let mut cut_run = full.clone();
+    cut_run.increments.truncate(cut);
+    cut_run.status = RunStatus::Stopped { reason: "cut by the test".into() };
+    let cut_path = dir.path().join("cut.scres");
+    cut_run.write(&cut_path).unwrap();
+    let continued = run("continued.scres", Some(&cut_path));
+    let origin = continued.restart.as_ref().expect("the restart origin is recorded");
+    assert_eq!((origin.increments as usize, origin.load_factor), (cut, full.increments[cut - 1].info.load_factor));
+    // the restart file's increments open the history, bit for bit (NaN marks what
+    // does not apply, e.g. iteration 0's energy, so compare bits, not values)
+    let bits = |r: &Results| -> Vec<u64> {
+        r.increments[..cut].iter().flat_map(|i| i.u.iter().flatten().chain(i.contact.iter().flatten().flatten()).chain(i.friction.iter().flatten().flatten()).map(|v| v.to_bits())).collect()
+    };
+    assert!(bits(&continued) == bits(&full), "the restart file's increments open the history");
+    forget(&mut cut_run.increments[cut - 1]);
+    cut_run.write(&cut_path).unwrap();
+    let forgetful = run("forgetful.scres", Some(&cut_path));
+    [full, continued, forgetful]
+}
+
+/// Largest displacement difference over the increments after `cut`, relative to the
+/// largest displacement.
+fn u_difference(a: &splinecontact::format::scres::Results, b: &splinecontact::format::scres::Results, cut: usize) -> f64 {
+    let scale = b.increments.iter().flat_map(|i| i.u.iter().flatten()).fold(0.0f64, |m, v| m.max(v.abs()));
+    a.increments[cut..].iter().zip(&b.increments[cut..]).flat_map(|(x, y)| x.u.iter().flatten().zip(y.u.iter().flatten()).map(|(p, q)| (p - q).abs())).fold(0.0f64, f64::max) / scale
+}
+
+/// Largest tangential-force difference over the increments after `cut`, in μN.
+fn h_difference(a: &splinecontact::format::scres::Results, b: &splinecontact::format::scres::Results, cut: usize) -> f64 {
+    let h = |i: &splinecontact::format::scres::Increment| i.info.contact[0].friction.as_ref().unwrap().tangential_force[0];
+    a.increments[cut..].iter().zip(&b.increments[cut..]).map(|(x, y)| (h(x) - h(y)).abs() / (MU * y.info.contact[0].force[2])).fold(0.0, f64::max)
+}
+
+/// Restart (`sc-solve --restart`), penalty path of the first test: cut at t = 2.4,
+/// where the block sticks after sliding and reversing, so its tangential traction is
+/// the stored t_{Tα,n} plus the elastic increment (eq. 4.7). The continued run
+/// computes the increments the uninterrupted run computed.
+///
+/// Tolerance 1e-9 of the largest displacement and of μN: the state read back is
+/// bit-exact, but the continued run's first closest-point projection starts afresh,
+/// so its Newton iterates could differ at the projection and Newton tolerances
+/// (measured: 0, bit for bit). The control: with t_{Tα,n} zeroed in the restart
+/// file the tangential force is off by more than 0.1 μN, so the comparison sees the
+/// history.
+#[test]
+fn restart_continues_the_run_it_was_cut_from() {
+    const CUT: usize = 24;
+    let [full, continued, forgetful] = cut_and_continue(&setup(), CUT, |inc| {
+        for row in inc.friction[0].iter_mut() {
+            row[6] = 0.0;
+            row[7] = 0.0;
+        }
+    });
+    let at_cut = &full.increments[CUT - 1].info.contact[0];
+    assert_eq!(at_cut.friction.as_ref().map(|f| (f.stick, f.slip)), Some((9, 0)), "t = 2.4 sticks: {at_cut:?}");
+    let (du, dh) = (u_difference(&continued, &full, CUT), h_difference(&continued, &full, CUT));
+    let miss = h_difference(&forgetful, &full, CUT);
+    eprintln!("penalty: continued run off by {du:.3e} max |u|, {dh:.3e} μN; without t_T,n: {miss:.3} μN");
+    assert!(du <= 1e-9 && dh <= 1e-9, "continued run differs: {du:e} of max |u|, {dh:e} μN");
+    for (a, b) in continued.increments[CUT..].iter().zip(&full.increments[CUT..]) {
+        let (fa, fb) = (a.info.contact[0].friction.as_ref().unwrap(), b.info.contact[0].friction.as_ref().unwrap());
+        assert_eq!((fa.stick, fa.slip), (fb.stick, fb.slip), "t = {}", a.info.load_factor);
+    }
+    assert!(miss > 0.1, "the comparison does not see the friction history ({miss:e} μN)");
+}
+
+/// Restart with the augmented Lagrangian (the path of the second test, ε_N = ε_T =
+/// 1e8, tolerance 1e-7), cut at t = 2.4: the Uzawa loop continues from the stored
+/// λ_N and t_{Tα,n}, so the continued run needs the same augmentations, increment
+/// by increment, and reaches the same state (tolerance 1e-9 as above). The
+/// control: with λ_N zeroed the first increment after the cut needs more
+/// augmentations (the multipliers are rebuilt from zero).
+#[test]
+fn restart_keeps_the_augmented_lagrangian_multipliers() {
+    const CUT: usize = 24;
+    let yaml = setup_with(1.0e8, 1.0e8, 2.0e-3).replace("enforcement: penalty", "enforcement: augmented_lagrangian, penetration_tolerance: 1.0e-7, max_augmentations: 30");
+    let [full, continued, forgetful] = cut_and_continue(&yaml, CUT, |inc| {
+        for row in inc.contact[0].iter_mut() {
+            row[2] = 0.0;
+        }
+    });
+    let aug = |r: &splinecontact::format::scres::Results| r.increments[CUT..].iter().map(|i| i.info.contact[0].augmentations).collect::<Vec<_>>();
+    let du = u_difference(&continued, &full, CUT);
+    eprintln!("augmented Lagrangian: continued run off by {du:.3e} max |u|; augmentations {:?}, continued {:?}, without λ_N {:?}", aug(&full), aug(&continued), aug(&forgetful));
+    assert!(du <= 1e-9, "continued run differs by {du:e} of max |u|");
+    assert_eq!(aug(&continued), aug(&full));
+    assert!(aug(&forgetful)[0] > aug(&full)[0], "the comparison does not see the multipliers");
+}

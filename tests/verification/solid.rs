@@ -23,7 +23,7 @@ pub fn try_run(mesh: &Mesh, setup_yaml: &str) -> Result<Results, String> {
     scmesh::write(&m, mesh, "test").unwrap();
     let setup = SolveSetup::parse("setup", setup_yaml).map_err(|e| e.to_string())?;
     let out = dir.path().join("r.scres");
-    let r = solve(&m, &setup, "setup", &out, None, Verbosity::Quiet);
+    let r = solve(&m, &setup, "setup", &out, None, None, Verbosity::Quiet);
     let results = Results::read(Path::new(&out)).ok();
     match (r, results) {
         (Ok(_), Some(res)) => Ok(res),
