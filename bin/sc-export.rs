@@ -43,6 +43,9 @@ fn main() -> ExitCode {
         Ok(msg) => {
             if !args.quiet && args.output.as_os_str() != "-" {
                 eprintln!("{msg}");
+            } else if let Some(warning) = msg.lines().find(|l| l.starts_with("warning: ")) {
+                // an incomplete results file is said even when quiet
+                eprintln!("sc-export: {warning}");
             }
             ExitCode::SUCCESS
         }

@@ -30,7 +30,7 @@ use splinecontact::stages::solve;
 /// A body held only by contact must start touching its master or be supported, and
 /// its rigid in-plane modes need supports (frictionless contact carries no shear).
 ///
-/// The results file (.scres) is rewritten after every converged increment, so a run
+/// Every converged increment is appended to the results file (.scres) at once, so a run
 /// that stops keeps everything it converged, with the contact state (gap, pressure,
 /// multiplier, active flag per slave node; force and augmentations per pair). The
 /// convergence history goes to a CSV (default: beside the results,
@@ -85,11 +85,12 @@ fn main() -> ExitCode {
         Ok(r) => {
             if !args.quiet {
                 eprintln!(
-                    "solved: {} increments, {} Newton iterations, {} cutbacks, {:.2} s; wrote {}",
+                    "solved: {} increments, {} Newton iterations, {} cutbacks, {:.2} s ({:.2} s writing results); wrote {}",
                     r.increments,
                     r.iterations,
                     r.cutbacks,
                     r.seconds,
+                    r.write_seconds,
                     args.output.display()
                 );
             }

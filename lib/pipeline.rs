@@ -90,7 +90,7 @@ pub fn run(path: &Path, verbosity: Verbosity, log: &mut dyn FnMut(&str)) -> Resu
                 let csv = s.csv.as_ref().map(|c| resolve(&base, c)).or_else(|| stages::solve::default_csv_path(&out));
                 let restart = s.restart.as_ref().map(|r| resolve(&base, r));
                 let r = stages::solve::solve(&input, &setup, &setup_name, &out, csv.as_deref(), restart.as_deref(), verbosity).map_err(fail)?;
-                log(&format!("      {} increments, {} Newton iterations, {} cutbacks, {:.2} s", r.increments, r.iterations, r.cutbacks, r.seconds));
+                log(&format!("      {} increments, {} Newton iterations, {} cutbacks, {:.2} s ({:.2} s writing results)", r.increments, r.iterations, r.cutbacks, r.seconds, r.write_seconds));
             }
             Stage::Export(s) => {
                 let (input, out) = (resolve(&base, &s.input), resolve(&base, &s.output));

@@ -1,26 +1,32 @@
-//! The results stage file, `.scres` (format `scres`, version 1.3): the mesh, the
+//! The results stage file, `.scres` (format `scres`, version 2.0): the mesh, the
 //! setup that produced it, and the full state of every converged increment
 //! (displacements, Cauchy stress at the Gauss points, reactions, convergence
 //! history), so that a run can be inspected, exported or restarted from it.
 //!
-//! The solver rewrites the file atomically after every converged increment, so the
-//! file on disk always holds every increment converged so far and never a partial one.
+//! The file grows by one segment per converged increment ([`ResultsFile`]): the
+//! first write creates it atomically (temporary file, renamed), every later
+//! increment is appended and synced, and the run's status closes it. What is on
+//! disk is always every increment converged so far; an append cut short by a crash
+//! is left out by readers (and said, [`Results::tail`]). Writing is linear in the
+//! run's length: 1.x rewrote the whole file after every increment.
 
-use std::path::Path;
+use std::fs;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
 use super::sccontact::{self, ContactPair, PairMeta};
 use super::scmesh;
-use super::stage::{write_atomic, StageError, StageFile, StageWriter};
+use super::stage::{write_atomic, SegmentEnd, StageError, StageFile, StageWriter};
 use crate::mesh::Mesh;
 
 pub const FORMAT: &str = "scres";
-pub const MAJOR: u32 = 1;
-/// 1.1: contact pairs and per-increment contact state (files without them read as
-/// 1.0 did). 1.2: `stabilization_force` in a pair's increment summary (absent when 0).
-/// 1.3: `restart`, the results file a restarted run continued (absent otherwise).
-pub const MINOR: u32 = 3;
+/// 2.0: one segment per increment, appended (1.x: one META listing every
+/// increment, the whole file rewritten after each).
+pub const MAJOR: u32 = 2;
+pub const MINOR: u32 = 0;
 
 /// One Newton iteration, as logged.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
@@ -160,21 +166,33 @@ pub struct RestartOrigin {
     pub load_factor: f64,
 }
 
+/// The first META record: the run.
 #[derive(Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct ResultsMeta {
     source: String,
-    /// `running`, `completed`, or `stopped: {reason: ...}` (not a YAML `!tag`).
-    #[serde(with = "serde_yaml::with::singleton_map")]
-    status: RunStatus,
     /// The solve setup, as given (YAML text).
     setup: String,
-    increments: Vec<IncrementInfo>,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pairs: Vec<PairMeta>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     restart: Option<RestartOrigin>,
 }
+
+/// The META record that opens each later segment: an increment's summary (its
+/// arrays follow), or the status that closes the run.
+#[derive(Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SegmentMeta {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    increment: Option<IncrementInfo>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    status: Option<StatusMeta>,
+}
+
+/// `completed`, or `stopped: {reason: ...}` (not a YAML `!tag`).
+#[derive(Debug, Serialize, Deserialize)]
+struct StatusMeta(#[serde(with = "serde_yaml::with::singleton_map")] RunStatus);
 
 /// A results file in memory.
 #[derive(Debug, Clone, PartialEq)]
@@ -188,16 +206,23 @@ pub struct Results {
     pub pairs: Vec<ContactPair>,
     /// A restarted run: the file it continued.
     pub restart: Option<RestartOrigin>,
+    /// Read from a file whose last bytes were not a complete segment (an append cut
+    /// short): why they were left out. Never written.
+    pub tail: Option<String>,
 }
 
 impl Results {
+    /// The whole file: the run's segment, one per increment, and the status unless
+    /// the run is still going.
     pub fn encode(&self) -> Vec<u8> {
+        self.encode_segments().0
+    }
+
+    fn encode_segments(&self) -> (Vec<u8>, SegmentEnd) {
         let mut w = StageWriter::new(FORMAT, MAJOR, MINOR);
         let meta = ResultsMeta {
             source: self.source.clone(),
-            status: self.status.clone(),
             setup: self.setup.clone(),
-            increments: self.increments.iter().map(|i| i.info.clone()).collect(),
             pairs: self.pairs.iter().map(sccontact::pair_meta).collect(),
             restart: self.restart.clone(),
         };
@@ -208,8 +233,17 @@ impl Results {
             // the pairs were checked when the contact model was read
             sccontact::write_pair_records(&mut w, k, p).expect("contact pair orders fit their nets");
         }
+        w.end_segment();
+        self.encode_tail(&mut w, 0);
+        w.finish_segments()
+    }
+
+    /// The segments of increments `first..` and, once the run ended, of its status.
+    fn encode_tail(&self, w: &mut StageWriter, first: usize) {
         let (n, m) = (self.mesh.nodes.len() as u64, self.mesh.hexes.len() as u64);
-        for (k, inc) in self.increments.iter().enumerate() {
+        for (k, inc) in self.increments.iter().enumerate().skip(first) {
+            let meta = SegmentMeta { increment: Some(inc.info.clone()), status: None };
+            w.meta(&serde_yaml::to_string(&meta).expect("increment metadata serialises"));
             let u: Vec<f64> = inc.u.iter().flatten().copied().collect();
             w.f64s(&format!("inc/{k}/u"), &[n, 3], &u);
             let s: Vec<f64> = inc.stress.iter().flatten().flatten().copied().collect();
@@ -222,8 +256,13 @@ impl Results {
                 let v: Vec<f64> = fr.iter().flatten().copied().collect();
                 w.f64s(&format!("inc/{k}/pair/{p}/friction"), &[fr.len() as u64, 9], &v);
             }
+            w.end_segment();
         }
-        w.finish()
+        if self.status != RunStatus::Running {
+            let meta = SegmentMeta { increment: None, status: Some(StatusMeta(self.status.clone())) };
+            w.meta(&serde_yaml::to_string(&meta).expect("status metadata serialises"));
+            w.end_segment();
+        }
     }
 
     /// Write atomically.
@@ -236,8 +275,19 @@ impl Results {
         let mesh_meta = f.meta.get(1).ok_or_else(|| f.invalid("META", "the mesh metadata record is missing"))?;
         let mesh = scmesh::read_mesh_records(f, "mesh/", mesh_meta)?;
         let pairs: Vec<ContactPair> = meta.pairs.into_iter().enumerate().map(|(k, pm)| sccontact::read_pair(f, k, pm, mesh.nodes.len())).collect::<Result<_, _>>()?;
-        let mut increments = Vec::with_capacity(meta.increments.len());
-        for (k, info) in meta.increments.into_iter().enumerate() {
+        // the later segments: increments in order, then the status (none yet: running)
+        let (mut infos, mut status) = (Vec::new(), RunStatus::Running);
+        for (r, text) in f.meta.iter().enumerate().skip(2) {
+            let name = format!("META {}", r + 1);
+            let seg: SegmentMeta = serde_yaml::from_str(text).map_err(|e| f.invalid(&name, e.to_string()))?;
+            match (seg.increment, seg.status) {
+                (Some(info), None) if status == RunStatus::Running => infos.push(info),
+                (None, Some(StatusMeta(s))) if status == RunStatus::Running => status = s,
+                _ => return Err(f.invalid(&name, "expected one increment (before the status) or the status")),
+            }
+        }
+        let mut increments = Vec::with_capacity(infos.len());
+        for (k, info) in infos.into_iter().enumerate() {
             let u = f.f64s(&format!("inc/{k}/u"), Some(3))?;
             if u.len() != 3 * mesh.nodes.len() {
                 return Err(f.invalid(&format!("inc/{k}/u"), format!("expected {} nodes", mesh.nodes.len())));
@@ -275,10 +325,65 @@ impl Results {
             }
             increments.push(Increment { info, u: u.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(), stress, contact, friction });
         }
-        Ok(Self { mesh, source: meta.source, setup: meta.setup, status: meta.status, increments, pairs, restart: meta.restart })
+        Ok(Self { mesh, source: meta.source, setup: meta.setup, status, increments, pairs, restart: meta.restart, tail: f.tail.clone() })
     }
 
     pub fn read(path: &Path) -> Result<Self, StageError> {
         Self::from_stage(&StageFile::read(path, Some((FORMAT, MAJOR)))?)
+    }
+}
+
+/// The results file of a running solve, written as the run goes: the first
+/// [`ResultsFile::sync`] creates it atomically with everything so far (a temporary
+/// file renamed onto it, so an existing file survives until then); each later one
+/// appends the increments converged since, and the status once the run ended, as
+/// segments, then syncs. A crash in an append leaves a partial last segment, which
+/// readers leave out.
+pub struct ResultsFile {
+    path: PathBuf,
+    /// The open file and where its last segment ended, once created.
+    open: Option<(fs::File, SegmentEnd)>,
+    /// Increments on disk; whether the status is.
+    written: usize,
+    closed: bool,
+    /// Bytes written and seconds spent writing (encoding, writing, syncing).
+    pub bytes: u64,
+    pub seconds: f64,
+}
+
+impl ResultsFile {
+    pub fn new(path: &Path) -> Self {
+        Self { path: path.to_path_buf(), open: None, written: 0, closed: false, bytes: 0, seconds: 0.0 }
+    }
+
+    /// Bring the file up to date with `results` (which only ever grows: more
+    /// increments, then a status).
+    pub fn sync(&mut self, results: &Results) -> Result<(), StageError> {
+        if self.closed {
+            return Ok(());
+        }
+        let start = Instant::now();
+        let shown = || self.path.display().to_string();
+        match &mut self.open {
+            None => {
+                let (bytes, end) = results.encode_segments();
+                write_atomic(&self.path, &bytes)?;
+                let file = fs::OpenOptions::new().append(true).open(&self.path).map_err(|source| StageError::Io { path: shown(), action: "open for appending", source })?;
+                self.bytes += bytes.len() as u64;
+                self.open = Some((file, end));
+            }
+            Some((file, end)) => {
+                let mut w = StageWriter::append_to(*end);
+                results.encode_tail(&mut w, self.written);
+                let (bytes, new_end) = w.finish_segments();
+                file.write_all(&bytes).and_then(|_| file.sync_data()).map_err(|source| StageError::Io { path: self.path.display().to_string(), action: "append to", source })?;
+                self.bytes += bytes.len() as u64;
+                *end = new_end;
+            }
+        }
+        self.written = results.increments.len();
+        self.closed = results.status != RunStatus::Running;
+        self.seconds += start.elapsed().as_secs_f64();
+        Ok(())
     }
 }

@@ -7,8 +7,14 @@
 //! records, each starting with a 4-byte tag:
 //!   "META" u64 len, UTF-8 YAML (small structured data: names, settings)
 //!   "ARRY" u32 name_len, name, u8 dtype, u8 ndim, u64 dims[ndim], payload
-//!   "END!" u64 number of records before it, u64 checksum of every byte before "END!"
+//!   "END!" u64 number of records before it, u64 checksum (chained over segments)
 //! ```
+//! A file is one or more **segments**, each a run of records closed by an `END!`.
+//! Files written at once have one; a results file grows by one segment per
+//! converged increment, appended to the file, so a long run never rewrites what it
+//! already wrote. A reader takes every complete segment; bytes after the last one
+//! that do not form a complete segment (an append interrupted by a crash) are
+//! left out and reported as [`StageFile::tail`].
 //! Bulk data is raw little-endian binary (fast: a 1M-hex mesh is ~90 MB and
 //! reads in a fraction of a second); everything small is YAML so `sc-export
 //! --format yaml` can print any stage file.
@@ -154,17 +160,50 @@ impl Checksum {
     }
 }
 
-/// Builds a stage file in memory; [`StageWriter::finish`] returns its bytes.
+/// Where a file's last segment ended: the record count and checksum the next
+/// segment continues from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SegmentEnd {
+    records: u64,
+    checksum: u64,
+}
+
+/// Builds a stage file (or segments to append to one) in memory;
+/// [`StageWriter::finish`] returns its bytes.
 pub struct StageWriter {
     buf: Vec<u8>,
     records: u64,
+    /// The checksum the current segment continues (that of the last `END!`).
+    chain: u64,
+    /// Where the current segment starts in `buf`.
+    segment_start: usize,
+    /// Whether any segment was closed.
+    closed: bool,
 }
 
 impl StageWriter {
     pub fn new(format: &str, major: u32, minor: u32) -> Self {
         let mut buf = Vec::with_capacity(1 << 16);
         buf.extend_from_slice(format!("{MAGIC} {format} {major}.{minor}\n").as_bytes());
-        Self { buf, records: 0 }
+        Self { buf, records: 0, chain: Checksum::new().0, segment_start: 0, closed: false }
+    }
+
+    /// Segments to append to a file whose last segment ended at `end` (no header).
+    pub fn append_to(end: SegmentEnd) -> Self {
+        Self { buf: Vec::with_capacity(1 << 16), records: end.records, chain: end.checksum, segment_start: 0, closed: true }
+    }
+
+    /// Close the current segment with its `END!`: the number of records in the file
+    /// so far, and the checksum of the segment's bytes continuing the last `END!`'s.
+    pub fn end_segment(&mut self) {
+        let mut c = Checksum(self.chain);
+        c.update(&self.buf[self.segment_start..]);
+        self.buf.extend_from_slice(b"END!");
+        self.buf.extend_from_slice(&self.records.to_le_bytes());
+        self.buf.extend_from_slice(&c.0.to_le_bytes());
+        self.chain = c.0;
+        self.segment_start = self.buf.len();
+        self.closed = true;
     }
 
     pub fn meta(&mut self, yaml: &str) {
@@ -214,14 +253,18 @@ impl StageWriter {
         self.buf.extend_from_slice(v);
     }
 
-    /// Append the end record and return the complete file contents.
-    pub fn finish(mut self) -> Vec<u8> {
-        let mut c = Checksum::new();
-        c.update(&self.buf);
-        self.buf.extend_from_slice(b"END!");
-        self.buf.extend_from_slice(&self.records.to_le_bytes());
-        self.buf.extend_from_slice(&c.0.to_le_bytes());
-        self.buf
+    /// Close the open segment (if it holds anything, or nothing was closed yet) and
+    /// return the bytes: the complete file, or the segments to append.
+    pub fn finish(self) -> Vec<u8> {
+        self.finish_segments().0
+    }
+
+    /// As [`Self::finish`], with where the last segment ended (to append more later).
+    pub fn finish_segments(mut self) -> (Vec<u8>, SegmentEnd) {
+        if !self.closed || self.buf.len() > self.segment_start {
+            self.end_segment();
+        }
+        (self.buf, SegmentEnd { records: self.records, checksum: self.chain })
     }
 }
 
@@ -236,6 +279,10 @@ pub struct StageFile {
     /// YAML metadata records, in file order (usually one).
     pub meta: Vec<String>,
     pub arrays: Vec<Array>,
+    /// Why the bytes after the last complete segment were left out (an append
+    /// interrupted by a crash leaves a partial segment); `None` when the file ends
+    /// with a complete segment.
+    pub tail: Option<String>,
 }
 
 struct Cursor<'a> {
@@ -268,6 +315,12 @@ impl<'a> Cursor<'a> {
     fn u8(&mut self, what: &str) -> Result<u8, StageError> {
         Ok(self.take(1, what)?[0])
     }
+}
+
+/// What [`StageFile::record`] read.
+enum Record {
+    Data,
+    End,
 }
 
 fn decode<T, const N: usize>(b: &[u8], f: fn([u8; N]) -> T) -> Vec<T> {
@@ -316,82 +369,115 @@ impl StageFile {
         let mut meta = Vec::new();
         let mut arrays = Vec::new();
         let mut records = 0u64;
-        loop {
-            let at = c.pos;
-            let tag = c.take(4, "a record tag")?;
-            match tag {
-                b"META" => {
-                    let len = c.u64("META length")? as usize;
-                    let text = c.take(len, "META text")?;
-                    let text = std::str::from_utf8(text).map_err(|e| StageError::Corrupt {
-                        path: path.to_string(),
-                        offset: at as u64,
-                        what: format!("META record is not UTF-8: {e}"),
-                    })?;
-                    meta.push(text.to_string());
-                }
-                b"ARRY" => {
-                    let name_len = c.u32("array name length")? as usize;
-                    if name_len > 4096 {
-                        return Err(StageError::Corrupt { path: path.to_string(), offset: at as u64, what: format!("array name length {name_len} is implausible") });
+        // the checksum the current segment continues, where it starts, and what the
+        // complete segments so far hold (records, META and array counts)
+        let (mut chain, mut segment_start) = (Checksum::new().0, 0usize);
+        let mut complete: Option<(u64, usize, usize)> = None;
+        let result = loop {
+            let r = Self::record(&mut c, bytes, path, &mut meta, &mut arrays, records, &mut chain, &mut segment_start);
+            match r {
+                Ok(Record::Data) => records += 1,
+                Ok(Record::End) => {
+                    complete = Some((records, meta.len(), arrays.len()));
+                    if c.pos == bytes.len() {
+                        break Ok(());
                     }
-                    let name = String::from_utf8_lossy(c.take(name_len, "array name")?).into_owned();
-                    let dt = c.u8("array dtype")?;
-                    let dtype = Dtype::from_u8(dt).ok_or_else(|| StageError::Corrupt {
-                        path: path.to_string(),
-                        offset: at as u64,
-                        what: format!("array '{name}' has unknown dtype code {dt}"),
-                    })?;
-                    let ndim = c.u8("array rank")? as usize;
-                    let mut dims = Vec::with_capacity(ndim);
-                    for _ in 0..ndim {
-                        dims.push(c.u64("array dimension")?);
-                    }
-                    let n = dims.iter().try_fold(1u64, |a, &d| a.checked_mul(d)).and_then(|n| n.checked_mul(dtype.size() as u64));
-                    let nbytes = match n {
-                        Some(n) if n <= bytes.len() as u64 => n as usize,
-                        _ => {
-                            return Err(StageError::Truncated {
-                                path: path.to_string(),
-                                offset: bytes.len() as u64,
-                                what: format!("array '{name}' of shape {dims:?} does not fit in the file"),
-                            })
-                        }
-                    };
-                    let b = c.take(nbytes, &format!("data of array '{name}'"))?;
-                    let data = match dtype {
-                        Dtype::F64 => ArrayData::F64(decode(b, f64::from_le_bytes)),
-                        Dtype::U32 => ArrayData::U32(decode(b, u32::from_le_bytes)),
-                        Dtype::U64 => ArrayData::U64(decode(b, u64::from_le_bytes)),
-                        Dtype::I32 => ArrayData::I32(decode(b, i32::from_le_bytes)),
-                        Dtype::U8 => ArrayData::U8(b.to_vec()),
-                    };
-                    arrays.push(Array { name, dims, data });
                 }
-                b"END!" => {
-                    let count = c.u64("END record count")?;
-                    let sum = c.u64("END checksum")?;
-                    if count != records {
-                        return Err(StageError::Corrupt { path: path.to_string(), offset: at as u64, what: format!("END says {count} records, found {records}") });
-                    }
-                    let mut ck = Checksum::new();
-                    ck.update(&bytes[..at]);
-                    if ck.0 != sum {
-                        return Err(StageError::Corrupt { path: path.to_string(), offset: at as u64, what: "checksum mismatch: the file was modified or damaged".into() });
-                    }
-                    break;
-                }
-                other => {
-                    return Err(StageError::Corrupt {
-                        path: path.to_string(),
-                        offset: at as u64,
-                        what: format!("unknown record tag {:?} (expected META, ARRY or END!)", String::from_utf8_lossy(other)),
-                    })
-                }
+                Err(e) => break Err(e),
             }
-            records += 1;
+        };
+        let tail = match (result, complete) {
+            (Ok(()), _) => None,
+            (Err(e), None) => return Err(e),
+            // a complete segment was read: what follows is an interrupted append
+            (Err(e), Some((_, n_meta, n_arrays))) => {
+                meta.truncate(n_meta);
+                arrays.truncate(n_arrays);
+                Some(format!("the {} bytes after byte {segment_start} are not a complete segment and were left out (an interrupted write?): {e}", bytes.len() - segment_start))
+            }
+        };
+        Ok(Self { path: path.to_string(), format, major, minor, meta, arrays, tail })
+    }
+
+    /// Reads one record at the cursor: a META or ARRY (pushed), or an END! (checked
+    /// against the record count and the chained checksum of its segment).
+    #[allow(clippy::too_many_arguments)]
+    fn record(c: &mut Cursor, bytes: &[u8], path: &str, meta: &mut Vec<String>, arrays: &mut Vec<Array>, records: u64, chain: &mut u64, segment_start: &mut usize) -> Result<Record, StageError> {
+        let at = c.pos;
+        let tag = c.take(4, "a record tag")?;
+        match tag {
+            b"META" => {
+                let len = c.u64("META length")? as usize;
+                let text = c.take(len, "META text")?;
+                let text = std::str::from_utf8(text).map_err(|e| StageError::Corrupt {
+                    path: path.to_string(),
+                    offset: at as u64,
+                    what: format!("META record is not UTF-8: {e}"),
+                })?;
+                meta.push(text.to_string());
+            }
+            b"ARRY" => {
+                let name_len = c.u32("array name length")? as usize;
+                if name_len > 4096 {
+                    return Err(StageError::Corrupt { path: path.to_string(), offset: at as u64, what: format!("array name length {name_len} is implausible") });
+                }
+                let name = String::from_utf8_lossy(c.take(name_len, "array name")?).into_owned();
+                let dt = c.u8("array dtype")?;
+                let dtype = Dtype::from_u8(dt).ok_or_else(|| StageError::Corrupt {
+                    path: path.to_string(),
+                    offset: at as u64,
+                    what: format!("array '{name}' has unknown dtype code {dt}"),
+                })?;
+                let ndim = c.u8("array rank")? as usize;
+                let mut dims = Vec::with_capacity(ndim);
+                for _ in 0..ndim {
+                    dims.push(c.u64("array dimension")?);
+                }
+                let n = dims.iter().try_fold(1u64, |a, &d| a.checked_mul(d)).and_then(|n| n.checked_mul(dtype.size() as u64));
+                let nbytes = match n {
+                    Some(n) if n <= bytes.len() as u64 => n as usize,
+                    _ => {
+                        return Err(StageError::Truncated {
+                            path: path.to_string(),
+                            offset: bytes.len() as u64,
+                            what: format!("array '{name}' of shape {dims:?} does not fit in the file"),
+                        })
+                    }
+                };
+                let b = c.take(nbytes, &format!("data of array '{name}'"))?;
+                let data = match dtype {
+                    Dtype::F64 => ArrayData::F64(decode(b, f64::from_le_bytes)),
+                    Dtype::U32 => ArrayData::U32(decode(b, u32::from_le_bytes)),
+                    Dtype::U64 => ArrayData::U64(decode(b, u64::from_le_bytes)),
+                    Dtype::I32 => ArrayData::I32(decode(b, i32::from_le_bytes)),
+                    Dtype::U8 => ArrayData::U8(b.to_vec()),
+                };
+                arrays.push(Array { name, dims, data });
+            }
+            b"END!" => {
+                let count = c.u64("END record count")?;
+                let sum = c.u64("END checksum")?;
+                if count != records {
+                    return Err(StageError::Corrupt { path: path.to_string(), offset: at as u64, what: format!("END says {count} records, found {records}") });
+                }
+                let mut ck = Checksum(*chain);
+                ck.update(&bytes[*segment_start..at]);
+                if ck.0 != sum {
+                    return Err(StageError::Corrupt { path: path.to_string(), offset: at as u64, what: "checksum mismatch: the file was modified or damaged".into() });
+                }
+                *chain = sum;
+                *segment_start = c.pos;
+                return Ok(Record::End);
+            }
+            other => {
+                return Err(StageError::Corrupt {
+                    path: path.to_string(),
+                    offset: at as u64,
+                    what: format!("unknown record tag {:?} (expected META, ARRY or END!)", String::from_utf8_lossy(other)),
+                })
+            }
         }
-        Ok(Self { path: path.to_string(), format, major, minor, meta, arrays })
+        Ok(Record::Data)
     }
 
     /// Read a file (or standard input for `-`) and parse it.
@@ -462,6 +548,9 @@ impl StageFile {
     pub fn dump_yaml(&self, out: &mut dyn Write) -> io::Result<()> {
         writeln!(out, "format: {}", self.format)?;
         writeln!(out, "version: \"{}.{}\"", self.major, self.minor)?;
+        if let Some(t) = &self.tail {
+            writeln!(out, "tail: {t:?}")?;
+        }
         for (i, m) in self.meta.iter().enumerate() {
             writeln!(out, "meta{}:", if i == 0 { String::new() } else { format!("_{i}") })?;
             for line in m.lines() {
@@ -598,6 +687,65 @@ mod tests {
         let i = b.len() / 2;
         b[i] ^= 0x10;
         assert!(StageFile::parse("t", &b, Some(("demo", 1))).is_err());
+    }
+
+    /// Two segments: the second appended later (from the first's end) gives the same
+    /// bytes as both written at once, and reads back as one file.
+    fn segmented() -> (Vec<u8>, usize) {
+        let mut w = StageWriter::new("demo", 1, 0);
+        w.meta("part: 0\n");
+        w.f64s("a", &[2], &[1.0, 2.0]);
+        let (mut bytes, end) = w.finish_segments();
+        let first = bytes.len();
+        let mut more = StageWriter::append_to(end);
+        more.meta("part: 1\n");
+        more.u32s("b", &[1], &[7]);
+        bytes.extend(more.finish());
+        (bytes, first)
+    }
+
+    #[test]
+    fn appended_segments_read_as_one_file() {
+        let (bytes, _) = segmented();
+        let mut w = StageWriter::new("demo", 1, 0);
+        w.meta("part: 0\n");
+        w.f64s("a", &[2], &[1.0, 2.0]);
+        w.end_segment();
+        w.meta("part: 1\n");
+        w.u32s("b", &[1], &[7]);
+        assert_eq!(w.finish(), bytes);
+        let f = StageFile::parse("t", &bytes, Some(("demo", 1))).unwrap();
+        assert_eq!((f.meta.len(), f.arrays.len(), f.tail.clone()), (2, 2, None));
+        assert_eq!(f.u32s("b", None).unwrap(), &[7]);
+        // a single segment is the one-segment layout of before (checksum from the
+        // FNV basis over every byte before END!)
+        let one = sample();
+        let mut c = Checksum::new();
+        c.update(&one[..one.len() - 20]);
+        assert_eq!(one[one.len() - 8..], c.0.to_le_bytes());
+    }
+
+    /// A file cut anywhere in its second segment reads as its first segment, and says
+    /// that the rest was left out; cut in the first, it is refused.
+    #[test]
+    fn an_interrupted_append_leaves_the_complete_segments() {
+        let (bytes, first) = segmented();
+        for n in 0..bytes.len() {
+            match StageFile::parse("t", &bytes[..n], Some(("demo", 1))) {
+                Ok(f) => {
+                    assert!(n >= first, "{n}: a cut first segment was accepted");
+                    assert_eq!((f.meta.len(), f.arrays.len()), (1, 1), "{n}");
+                    assert_eq!(f.tail.is_some(), n > first, "{n}: {:?}", f.tail);
+                }
+                Err(e) => assert!(n < first, "{n}: {e}"),
+            }
+        }
+        // a damaged byte in the second segment: left out with the rest, and said
+        let mut b = bytes.clone();
+        b[first + 6] ^= 0x10;
+        let f = StageFile::parse("t", &b, Some(("demo", 1))).unwrap();
+        assert!(f.tail.as_deref().is_some_and(|t| t.contains(&format!("after byte {first}"))), "{:?}", f.tail);
+        assert!(f.array("b").is_none());
     }
 
     #[test]

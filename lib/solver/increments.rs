@@ -20,7 +20,7 @@ use super::problem::Problem;
 use super::restart::RestartPoint;
 use crate::assembly::DOFS_PER_NODE;
 use crate::fem::element::hex8_min_jacobian;
-use crate::format::scres::{Increment, IncrementInfo, Reaction, Results, RunStatus};
+use crate::format::scres::{Increment, IncrementInfo, Reaction, Results, ResultsFile, RunStatus};
 use crate::format::stage::{write_atomic, StageError};
 
 /// The solve stopped.
@@ -51,6 +51,9 @@ pub struct SolveSummary {
     pub increments: usize,
     pub iterations: usize,
     pub cutbacks: u32,
+    /// Writing the results file: seconds (encode, write, sync) and bytes.
+    pub write_seconds: f64,
+    pub write_bytes: u64,
 }
 
 /// Where the results go.
@@ -210,17 +213,8 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
     };
     let first = factors.len() - start.map_or(factors.len(), |point| point.remaining(factors));
     let mut trial = u.clone();
-    let mut summary = SolveSummary { increments: 0, iterations: 0, cutbacks: 0 };
-    let write = |results: &Results, log: &SolveLog| -> Result<(), StageError> {
-        results.write(out.results)?;
-        if let Some(csv) = out.csv {
-            write_atomic(csv, log.csv().as_bytes())?;
-        }
-        if let Some(f) = out.forces_csv {
-            write_atomic(f, forces_csv(results).as_bytes())?;
-        }
-        Ok(())
-    };
+    let mut summary = SolveSummary { increments: 0, iterations: 0, cutbacks: 0, write_seconds: 0.0, write_bytes: 0 };
+    let mut file = ResultsFile::new(out.results);
     let n_inc = factors.len();
     for (k, &target) in factors.iter().enumerate().skip(first) {
         let mut lambda = target;
@@ -262,7 +256,7 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
                         Ok(s) => s,
                         Err((element, error)) => {
                             let failure = IncrementFailure::Element { iteration: 0, element, error };
-                            return Err(stop(p, &trial, results, out, log, k + 1, lambda, lambda_prev, cutbacks_this, failure));
+                            return Err(stop(p, &trial, results, &mut file, out, log, k + 1, lambda, lambda_prev, cutbacks_this, failure));
                         }
                     };
                     summary.iterations += conv.iterations.len().saturating_sub(1);
@@ -298,16 +292,13 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
                     }
                     newton.commit_increment(&u, lambda);
                     results.increments.push(Increment {
-                        info: IncrementInfo { load_factor: lambda, cutbacks: cutbacks_this, iterations: conv.iterations, reactions, seconds_output: 0.0, contact: summaries },
+                        info: IncrementInfo { load_factor: lambda, cutbacks: cutbacks_this, iterations: conv.iterations, reactions, seconds_output: t.elapsed().as_secs_f64(), contact: summaries },
                         u: u.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
                         stress,
                         contact: states,
                         friction,
                     });
-                    write(results, log)?;
-                    if let Some(last) = results.increments.last_mut() {
-                        last.info.seconds_output = t.elapsed().as_secs_f64();
-                    }
+                    write(&mut file, results, out, log)?;
                     summary.increments += 1;
                     log.line(&format!(
                         "increment {}/{n_inc} converged at load factor {lambda:.6} in {} iterations{}",
@@ -328,7 +319,7 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
                     }
                     failures += 1;
                     if failures > max_cutbacks {
-                        return Err(stop(p, &trial, results, out, log, k + 1, lambda, lambda_prev, cutbacks_this, failure));
+                        return Err(stop(p, &trial, results, &mut file, out, log, k + 1, lambda, lambda_prev, cutbacks_this, failure));
                     }
                     cutbacks_this += 1;
                     summary.cutbacks += 1;
@@ -341,16 +332,31 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
         log.increment_done();
     }
     results.status = RunStatus::Completed;
-    write(results, log)?;
+    write(&mut file, results, out, log)?;
+    log.line(&format!("results: {} increments, {:.1} MB written to {} in {:.2} s", results.increments.len(), file.bytes as f64 / 1e6, out.results.display(), file.seconds));
+    (summary.write_seconds, summary.write_bytes) = (file.seconds, file.bytes);
     Ok(summary)
 }
 
+/// Bring the results file up to date (append what converged since) and rewrite the
+/// two CSV histories.
+fn write(file: &mut ResultsFile, results: &Results, out: &Outputs, log: &SolveLog) -> Result<(), StageError> {
+    file.sync(results)?;
+    if let Some(csv) = out.csv {
+        write_atomic(csv, log.csv().as_bytes())?;
+    }
+    if let Some(f) = out.forces_csv {
+        write_atomic(f, forces_csv(results).as_bytes())?;
+    }
+    Ok(())
+}
+
 #[allow(clippy::too_many_arguments)]
-fn stop(p: &Problem, trial: &[f64], results: &mut Results, out: &Outputs, log: &SolveLog, increment: usize, load_factor: f64, last_converged: f64, cutbacks: u32, failure: IncrementFailure) -> SolveError {
+fn stop(p: &Problem, trial: &[f64], results: &mut Results, file: &mut ResultsFile, out: &Outputs, log: &SolveLog, increment: usize, load_factor: f64, last_converged: f64, cutbacks: u32, failure: IncrementFailure) -> SolveError {
     let worst = worst_element(p, results, &failure, trial);
     let reason = format!("increment {increment} at load factor {load_factor:.6}: {failure}{worst}");
     results.status = RunStatus::Stopped { reason };
-    if let Err(e) = results.write(out.results) {
+    if let Err(e) = file.sync(results) {
         return SolveError::Write(e);
     }
     if let Some(csv) = out.csv {

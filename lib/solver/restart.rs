@@ -38,6 +38,8 @@ pub struct RestartPoint {
     pub file: PathBuf,
     /// Its converged increments, oldest first (at least one).
     pub increments: Vec<Increment>,
+    /// Why its last bytes were left out, if they were (an interrupted write).
+    pub tail: Option<String>,
 }
 
 impl RestartPoint {
@@ -87,7 +89,7 @@ impl RestartPoint {
         if results.increments.is_empty() {
             return Err(mismatch("it holds no converged increment".into()));
         }
-        Ok(Self { file: file.to_path_buf(), increments: results.increments })
+        Ok(Self { file: file.to_path_buf(), increments: results.increments, tail: results.tail })
     }
 
     /// The last converged increment: the state to continue from.

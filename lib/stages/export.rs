@@ -68,7 +68,11 @@ pub fn export(input: &Path, output: &Path, format: Option<ExportFormat>) -> Resu
         ExportFormat::Pvd => match file.format.as_str() {
             scres::FORMAT => {
                 let results = Results::from_stage(&file)?;
-                write_results_pvd(&results, output)
+                let written = write_results_pvd(&results, output)?;
+                Ok(match &results.tail {
+                    Some(t) => format!("{written}\nwarning: {}: {t}", input.display()),
+                    None => written,
+                })
             }
             other => Err(StageRunError::Usage(format!(
                 "{}: a '{other}' file holds no time series; .pvd is written for results files (use .vtu for a mesh)",

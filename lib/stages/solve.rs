@@ -22,6 +22,8 @@ pub struct SolveReport {
     pub iterations: usize,
     pub cutbacks: u32,
     pub seconds: f64,
+    /// Of which writing the results file (encode, write, sync).
+    pub write_seconds: f64,
 }
 
 /// The CSV beside a results file: `results.scres` → `results.convergence.csv`. (The
@@ -106,6 +108,7 @@ pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, 
         mesh,
         pairs,
         restart: None,
+        tail: None,
     };
     if let Some(point) = &point {
         // the restart file's increments open the history, and its iterations the CSV
@@ -117,12 +120,13 @@ pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, 
         results.increments = point.increments.clone();
         results.restart = Some(RestartOrigin { file: point.file.display().to_string(), increments: point.increments.len() as u32, load_factor: point.load_factor() });
         log.line(&format!(
-            "restart from {}: {} converged increments, continuing from load factor {:.6} ({} of the setup's {} increments left)",
+            "restart from {}: {} converged increments, continuing from load factor {:.6} ({} of the setup's {} increments left){}",
             point.file.display(),
             point.increments.len(),
             point.load_factor(),
             point.remaining(&factors),
-            factors.len()
+            factors.len(),
+            point.tail.as_ref().map_or(String::new(), |t| format!("; warning: {t}"))
         ));
     }
     let forces = output.with_extension("forces.csv");
@@ -133,5 +137,5 @@ pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, 
     }
     log.finish();
     let summary = summary?;
-    Ok(SolveReport { increments: summary.increments, iterations: summary.iterations, cutbacks: summary.cutbacks, seconds: start.elapsed().as_secs_f64() })
+    Ok(SolveReport { increments: summary.increments, iterations: summary.iterations, cutbacks: summary.cutbacks, seconds: start.elapsed().as_secs_f64(), write_seconds: summary.write_seconds })
 }

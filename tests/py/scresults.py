@@ -3,8 +3,8 @@
 - last_vtu(path): the last increment's .vtu of a results .pvd (or a .vtu as given).
 - scres_summary(scres): the per-increment reactions and contact-pair summaries of a
   .scres, read from `sc-export FILE --format yaml -o -` (sc-export from $SC_EXPORT,
-  else PATH). The venv has no PyYAML, so a small block-YAML reader parses the part of
-  the dump we need (meta.increments; the big `arrays` section is never parsed).
+  else PATH). A small block-YAML reader parses the part of the dump we need (the
+  `increment:` META records; the big `arrays` section is never parsed).
 - convergence(csv): per increment, from <results>.convergence.csv: Newton
   corrections (rows with iteration >= 1, i.e. linear solves), augmentation passes,
   attempts (1 + cutbacks) and the contact-search/assembly/factor/solve seconds.
@@ -94,23 +94,25 @@ def _parse(lines, i, ind):
 
 
 def scres_summary(scres):
-    """meta.increments of a .scres (list of dicts: load_factor, cutbacks, iterations,
-    reactions [{set, force}], contact [{pair, force, active, max_penetration, ...}])."""
+    """The increments' summaries of a .scres (list of dicts: load_factor, cutbacks,
+    iterations, reactions [{set, force}], contact [{pair, force, active,
+    max_penetration, ...}]): in scres 2.0 each increment's segment opens with a META
+    `increment:` record, dumped as `meta_<r>:` / `  increment:` / its map at indent 4."""
     exe = os.environ.get("SC_EXPORT") or shutil.which("sc-export")
     if not exe:
         raise SystemExit("sc-export not found: put it on PATH or set SC_EXPORT")
     text = subprocess.run([exe, scres, "--format", "yaml", "-o", "-"], check=True,
                           capture_output=True, text=True).stdout
     lines = text.split("\n")
-    head = [i for i, l in enumerate(lines) if l.startswith("  increments:")]
-    if not head or lines[head[0]].strip() == "increments: []":
-        return []
-    start = head[0] + 1
-    end = start
-    while end < len(lines) and (_indent(lines[end]) > 2 or lines[end].startswith("  -")):
-        end += 1
-    section = [l for l in lines[start:end] if l.strip()]
-    incs, _ = _parse(section, 0, 2)
+    incs = []
+    for i, line in enumerate(lines[:-1]):
+        if line.startswith("meta_") and lines[i + 1].rstrip() == "  increment:":
+            end = i + 2
+            while end < len(lines) and (not lines[end].strip() or _indent(lines[end]) >= 4):
+                end += 1
+            section = [l for l in lines[i + 2:end] if l.strip()]
+            inc, _ = _parse(section, 0, 4)
+            incs.append(inc)
     return incs
 
 
