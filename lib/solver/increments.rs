@@ -225,21 +225,7 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
             let attempt = cutbacks_this;
             let outcome = {
                 let mut on_it = |row: &crate::format::scres::IterationLog| {
-                    log.iteration(&IterationEvent {
-                        increment: k + 1,
-                        n_increments: n_inc,
-                        load_factor: lambda,
-                        attempt,
-                        iteration: row.iteration,
-                        residual: row.residual,
-                        energy: row.energy,
-                        seconds_assembly: row.seconds_assembly,
-                        seconds_factor: row.seconds_factor,
-                        seconds_solve: row.seconds_solve,
-                        seconds_contact: row.seconds_contact,
-                        contact_active: row.contact_active,
-                        augmentation: row.augmentation,
-                    })
+                    log.iteration(&IterationEvent::from_row(k + 1, n_inc, lambda, attempt, row))
                 };
                 let mut notes = Vec::new();
                 let r = solve_augmented(newton, lambda, &mut trial, &mut on_it, &mut |s: &str| notes.push(s.to_string()));

@@ -6,7 +6,7 @@ use std::io::{IsTerminal, Write};
 
 use indicatif::{ProgressBar, ProgressStyle};
 
-use crate::format::scres::IncrementInfo;
+use crate::format::scres::{IncrementInfo, IterationLog};
 
 /// How much to print.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -33,6 +33,28 @@ pub struct IterationEvent {
     pub contact_active: u32,
     /// Uzawa update the Newton solve follows.
     pub augmentation: u32,
+}
+
+impl IterationEvent {
+    /// A logged Newton iteration `row` of attempt `attempt` of increment `increment`
+    /// (of `n_increments`) at load factor `load_factor`.
+    pub fn from_row(increment: usize, n_increments: usize, load_factor: f64, attempt: u32, row: &IterationLog) -> Self {
+        Self {
+            increment,
+            n_increments,
+            load_factor,
+            attempt,
+            iteration: row.iteration,
+            residual: row.residual,
+            energy: row.energy,
+            seconds_assembly: row.seconds_assembly,
+            seconds_factor: row.seconds_factor,
+            seconds_solve: row.seconds_solve,
+            seconds_contact: row.seconds_contact,
+            contact_active: row.contact_active,
+            augmentation: row.augmentation,
+        }
+    }
 }
 
 /// Progress reporting plus the CSV history.
@@ -92,21 +114,7 @@ impl SolveLog {
     /// back before it are not in the file. Only the CSV gets them.
     pub fn restored(&mut self, increment: usize, n_increments: usize, info: &IncrementInfo) {
         for row in &info.iterations {
-            self.push_csv(&IterationEvent {
-                increment,
-                n_increments,
-                load_factor: info.load_factor,
-                attempt: info.cutbacks,
-                iteration: row.iteration,
-                residual: row.residual,
-                energy: row.energy,
-                seconds_assembly: row.seconds_assembly,
-                seconds_factor: row.seconds_factor,
-                seconds_solve: row.seconds_solve,
-                seconds_contact: row.seconds_contact,
-                contact_active: row.contact_active,
-                augmentation: row.augmentation,
-            });
+            self.push_csv(&IterationEvent::from_row(increment, n_increments, info.load_factor, info.cutbacks, row));
         }
         if let Some(b) = &self.bar {
             b.set_position(increment as u64);
