@@ -156,7 +156,7 @@ pub struct Increment {
     pub friction: Vec<Vec<[f64; 9]>>,
 }
 
-/// Where a restarted run came from (1.3): its first `increments` increments are those
+/// Where a restarted run came from: its first `increments` increments are those
 /// of `file`, the last at `load_factor`.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
