@@ -45,6 +45,8 @@ use splinecontact::stages::solve;
 ///   sc-solve two.sccontact --setup contact.yaml -o two.scres
 ///   sc-solve two.sccontact --setup longer.yaml -o two.scres --restart two.scres
 ///                                              # continue a stopped or finished run
+///   sc-solve two.sccontact --setup finer.yaml -o redo.scres --restart two.scres --restart-increment 12
+///                                              # redo the path from increment 12
 #[derive(Parser)]
 #[command(version, about, long_about, verbatim_doc_comment)]
 struct Args {
@@ -65,6 +67,11 @@ struct Args {
     /// output starts with its increments. It may be the output file itself.
     #[arg(long, value_name = "SCRES")]
     restart: Option<PathBuf>,
+    /// With --restart: continue from this converged increment of the file instead
+    /// of its last (1-based, as the `increment` column of its forces CSV); the
+    /// increments after it are not carried over.
+    #[arg(long, value_name = "K", requires = "restart")]
+    restart_increment: Option<usize>,
     /// Print nothing but errors.
     #[arg(short, long)]
     quiet: bool,
@@ -81,7 +88,7 @@ fn main() -> ExitCode {
     };
     let csv = args.csv.clone().or_else(|| solve::default_csv_path(&args.output));
     let verbosity = if args.quiet { Verbosity::Quiet } else { Verbosity::Normal };
-    match solve::solve(&args.input, &setup, &args.setup.display().to_string(), &args.output, csv.as_deref(), args.restart.as_deref(), verbosity) {
+    match solve::solve(&args.input, &setup, &args.setup.display().to_string(), &args.output, csv.as_deref(), args.restart.as_deref().map(|file| solve::Restart { file, increment: args.restart_increment }), verbosity) {
         Ok(r) => {
             if !args.quiet {
                 eprintln!(

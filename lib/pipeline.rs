@@ -74,6 +74,10 @@ pub fn run(path: &Path, verbosity: Verbosity, log: &mut dyn FnMut(&str)) -> Resu
                 let (input, out) = (resolve(&base, &s.input), resolve(&base, &s.output));
                 log(&format!("[{index}/{n}] solve {} -> {}", input.display(), out.display()));
                 ensure_parent(&out).map_err(fail)?;
+                let restart_file = s.restart.as_ref().map(|r| resolve(&base, r));
+                if s.restart_increment.is_some() && restart_file.is_none() {
+                    return Err(fail(StageRunError::Usage(format!("{}: solve stage {index}: `restart_increment` needs `restart` (the results file to continue)", path.display()))));
+                }
                 let (setup, setup_name) = match (&s.setup, &s.setup_file) {
                     (Some(setup), None) => (setup.clone(), format!("{} (solve stage {index})", path.display())),
                     (None, Some(f)) => {
@@ -88,8 +92,8 @@ pub fn run(path: &Path, verbosity: Verbosity, log: &mut dyn FnMut(&str)) -> Resu
                     }
                 };
                 let csv = s.csv.as_ref().map(|c| resolve(&base, c)).or_else(|| stages::solve::default_csv_path(&out));
-                let restart = s.restart.as_ref().map(|r| resolve(&base, r));
-                let r = stages::solve::solve(&input, &setup, &setup_name, &out, csv.as_deref(), restart.as_deref(), verbosity).map_err(fail)?;
+                let restart = restart_file.as_deref().map(|file| stages::solve::Restart { file, increment: s.restart_increment });
+                let r = stages::solve::solve(&input, &setup, &setup_name, &out, csv.as_deref(), restart, verbosity).map_err(fail)?;
                 log(&format!("      {} increments, {} Newton iterations, {} cutbacks, {:.2} s ({:.2} s writing results)", r.increments, r.iterations, r.cutbacks, r.seconds, r.write_seconds));
             }
             Stage::Export(s) => {

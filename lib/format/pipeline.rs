@@ -118,6 +118,10 @@ pub struct SolveStage {
     /// (`sc-solve --restart`).
     #[serde(default)]
     pub restart: Option<PathBuf>,
+    /// ... or from this one of its converged increments (1-based;
+    /// `sc-solve --restart-increment`).
+    #[serde(default)]
+    pub restart_increment: Option<usize>,
 }
 
 #[derive(Debug, Deserialize)]

@@ -8,6 +8,10 @@
 //! left it, so the increments that follow are those the uninterrupted run would have
 //! computed (the test `restart_continues_the_run_it_was_cut_from` compares them).
 //!
+//! By default the run continues from the file's last converged increment; it can
+//! go back to an earlier one (a path to redo with smaller increments), the later
+//! increments then being dropped from the new results.
+//!
 //! The restart file must come from the same model: the same mesh and the same
 //! contact pairs (slave nodes, master net, master kind and orders). The setup may
 //! differ, typically by a longer load path or more cutbacks; the increments whose
@@ -44,13 +48,14 @@ pub struct RestartPoint {
 
 impl RestartPoint {
     /// Read `file` and check that it belongs to the model (`mesh`, `pairs`) about to
-    /// be solved.
-    pub fn read(file: &Path, mesh: &Mesh, pairs: &[ContactPair]) -> Result<Self, RestartError> {
-        Self::from_results(file, Results::read(file)?, mesh, pairs)
+    /// be solved; continue from its converged increment number `increment` (1-based,
+    /// as in its forces CSV) or, without one, from its last.
+    pub fn read(file: &Path, increment: Option<usize>, mesh: &Mesh, pairs: &[ContactPair]) -> Result<Self, RestartError> {
+        Self::from_results(file, Results::read(file)?, increment, mesh, pairs)
     }
 
     /// As [`Self::read`], from results already in memory (`file` names them in errors).
-    pub fn from_results(file: &Path, results: Results, mesh: &Mesh, pairs: &[ContactPair]) -> Result<Self, RestartError> {
+    pub fn from_results(file: &Path, mut results: Results, increment: Option<usize>, mesh: &Mesh, pairs: &[ContactPair]) -> Result<Self, RestartError> {
         let mismatch = |message: String| RestartError::Mismatch { file: file.display().to_string(), message };
         let r = &results;
         if r.mesh.nodes.len() != mesh.nodes.len() || r.mesh.hexes.len() != mesh.hexes.len() {
@@ -88,6 +93,13 @@ impl RestartPoint {
         }
         if results.increments.is_empty() {
             return Err(mismatch("it holds no converged increment".into()));
+        }
+        match increment {
+            Some(k) if k == 0 || k > results.increments.len() => {
+                return Err(mismatch(format!("it holds converged increments 1 to {}, not increment {k}", results.increments.len())));
+            }
+            Some(k) => results.increments.truncate(k),
+            None => {}
         }
         Ok(Self { file: file.to_path_buf(), increments: results.increments, tail: results.tail })
     }

@@ -16,6 +16,14 @@ use crate::solver::newton::Newton;
 use crate::solver::problem::Problem;
 use crate::solver::restart::RestartPoint;
 
+/// Where a solve restarts: a results file and, optionally, which of its converged
+/// increments (1-based; default its last).
+#[derive(Debug, Clone, Copy)]
+pub struct Restart<'a> {
+    pub file: &'a Path,
+    pub increment: Option<usize>,
+}
+
 /// What a finished solve reports.
 pub struct SolveReport {
     pub increments: usize,
@@ -33,10 +41,11 @@ pub fn default_csv_path(output: &Path) -> Option<std::path::PathBuf> {
 }
 
 /// Solve `setup` on the mesh in `input`, writing `output` after every converged
-/// increment and the convergence history to `csv`; with `restart`, continue from the
-/// last increment of that results file (of the same model), whose increments then
-/// open `output` (which may be the same file: it is read before anything is written).
-pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, csv: Option<&Path>, restart: Option<&Path>, verbosity: Verbosity) -> Result<SolveReport, StageRunError> {
+/// increment and the convergence history to `csv`; with `restart`, continue from an
+/// increment of that results file (of the same model; by default its last), whose
+/// increments up to it then open `output` (which may be the same file: it is read
+/// before anything is written).
+pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, csv: Option<&Path>, restart: Option<Restart>, verbosity: Verbosity) -> Result<SolveReport, StageRunError> {
     if output.as_os_str() == "-" {
         return Err(StageRunError::Usage("sc-solve writes its results after every increment: give a file with -o, not -".into()));
     }
@@ -50,7 +59,7 @@ pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, 
         }
         other => return Err(StageRunError::Usage(format!("{}: a {other} file; sc-solve reads a mesh (.scmesh) or a contact model (.sccontact)", input.display()))),
     };
-    let point = restart.map(|file| RestartPoint::read(file, &mesh, &pairs)).transpose()?;
+    let point = restart.map(|r| RestartPoint::read(r.file, r.increment, &mesh, &pairs)).transpose()?;
     let problem = Problem::with_contact(&mesh, &pairs, setup, setup_name)?;
     let factors = setup.load_factors(setup_name)?;
     if let Some(point) = &point {

@@ -109,6 +109,14 @@ fn pipeline_unknown_key() {
 }
 
 #[test]
+fn pipeline_restart_increment_without_restart() {
+    pipeline_fails(
+        "version: 1\nstages:\n  - solve: {input: m.scmesh, output: out.scmesh, setup_file: s.yaml, restart_increment: 3}\n",
+        &["p.yaml: solve stage 1: `restart_increment` needs `restart`"],
+    );
+}
+
+#[test]
 fn pipeline_wrong_type() {
     pipeline_fails("version: 1\nstages:\n  - gmsh: {geo: a.geo, output: out.scmesh, binary: 3}\n", &["p.yaml", "line 3"]);
 }

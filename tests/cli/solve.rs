@@ -214,3 +214,33 @@ fn results_file_appends_and_survives_a_cut_append() {
     let healed = Results::read(&dir.path().join("cut.scres")).unwrap();
     assert_eq!((healed.increments.len(), &healed.status, &healed.tail), (5, &RunStatus::Completed, &None));
 }
+
+/// `--restart-increment K`: back to an earlier increment of a finished run, redone
+/// with finer increments into a new file (the later increments are not carried
+/// over); the elastic end state equals the first run's to 1e-6. K outside the file,
+/// or without --restart: exit 2, nothing written.
+#[test]
+fn restart_from_an_earlier_increment() {
+    use splinecontact::format::scres::Results;
+    let dir = tempdir();
+    imported_cantilever(dir.path());
+    write_setup(dir.path(), GOOD);
+    let o = run("sc-solve", &["c.scmesh", "--setup", "setup.yaml", "-o", "r.scres", "-q"], dir.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    write_setup(dir.path(), &GOOD.replace("increments: {count: 5}", "increments: {count: 10}"));
+    let o = run("sc-solve", &["c.scmesh", "--setup", "setup.yaml", "-o", "redo.scres", "--restart", "r.scres", "--restart-increment", "2"], dir.path());
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("restart from r.scres: 2 converged increments, continuing from load factor 0.400000 (6 of the setup's 10 increments left)"), "{err}");
+    let (first, redo) = (Results::read(&dir.path().join("r.scres")).unwrap(), Results::read(&dir.path().join("redo.scres")).unwrap());
+    let factors: Vec<f64> = redo.increments.iter().map(|i| i.info.load_factor).collect();
+    assert_eq!(factors.len(), 8, "{factors:?}");
+    assert!(factors.iter().zip([0.2, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0]).all(|(a, b)| (a - b).abs() < 1e-12), "{factors:?}");
+    assert_eq!(redo.restart.as_ref().map(|o| (o.increments, o.load_factor)), Some((2, 0.4)));
+    let tip = |r: &Results| r.increments.last().unwrap().u.iter().map(|u| u[2]).fold(0.0f64, |m, v| m.max(v.abs()));
+    assert!((tip(&redo) - tip(&first)).abs() <= 1e-6 * tip(&first), "{} vs {}", tip(&redo), tip(&first));
+    let o = run("sc-solve", &["c.scmesh", "--setup", "setup.yaml", "-o", "x.scres", "--restart", "r.scres", "--restart-increment", "6"], dir.path());
+    assert_fails(&o, 2, &["r.scres: cannot restart from it: it holds converged increments 1 to 5, not increment 6"], &dir.path().join("x.scres"));
+    let o = run("sc-solve", &["c.scmesh", "--setup", "setup.yaml", "-o", "x.scres", "--restart-increment", "2"], dir.path());
+    assert_fails(&o, 2, &["--restart"], &dir.path().join("x.scres"));
+}

@@ -153,7 +153,7 @@ fn cut_and_continue(yaml: &str, cut: usize, forget: impl Fn(&mut splinecontact::
     use splinecontact::format::scres::{Results, RunStatus};
     use splinecontact::format::setup::SolveSetup;
     use splinecontact::solver::log::Verbosity;
-    use splinecontact::stages::solve::solve;
+    use splinecontact::stages::solve::{solve, Restart};
     use splinecontact::stages::tag::build_model;
 
     let mesh = two_bodies("lower", &block([2, 2, 1], [1.0, 1.0, 0.5], 0.0), "upper", &block([2, 2, 1], [0.5, 0.5, 0.25], 0.0), [0.25, 0.25, 0.5]);
@@ -164,7 +164,7 @@ fn cut_and_continue(yaml: &str, cut: usize, forget: impl Fn(&mut splinecontact::
     let s = SolveSetup::parse("setup", yaml).unwrap();
     let run = |out: &str, restart: Option<&std::path::Path>| {
         let out = dir.path().join(out);
-        if let Err(e) = solve(&c, &s, "setup", &out, None, restart, Verbosity::Quiet) {
+        if let Err(e) = solve(&c, &s, "setup", &out, None, restart.map(|file| Restart { file, increment: None }), Verbosity::Quiet) {
             panic!("{}: {e}", out.display());
         }
         let r = Results::read(&out).unwrap();
