@@ -60,11 +60,7 @@ impl NodeGroups {
 
     /// Appends one group.
     pub fn push(&mut self, nodes: &[u32]) {
-        if self.offsets.is_empty() {
-            self.offsets.push(0);
-        }
-        self.nodes.extend_from_slice(nodes);
-        self.offsets.push(self.nodes.len());
+        self.push_iter(nodes.iter().copied());
     }
 
     /// Appends one group from an iterator (no intermediate list).

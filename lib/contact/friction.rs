@@ -235,10 +235,8 @@ fn evaluate(
         // t_T = t_Tα ā^{αβ} ā_β: the friction force on the slave is −A_s t_T itself and
         // stays continuous where the curvature b̄ jumps (the knots of an order-3
         // master). On a crease the metric is the projected one, the tangent normal to n.
-        let t_vec: D3 = [0, 1, 2].map(|c| {
-            let up = [met_inv[0][0] * t_t[0] + met_inv[0][1] * t_t[1], met_inv[1][0] * t_t[0] + met_inv[1][1] * t_t[1]];
-            up[0] * a_t[0][c] + up[1] * a_t[1][c]
-        });
+        let t_up = [met_inv[0][0] * t_t[0] + met_inv[0][1] * t_t[1], met_inv[1][0] * t_t[0] + met_inv[1][1] * t_t[1]];
+        let t_vec: D3 = [0, 1, 2].map(|c| t_up[0] * a_t[0][c] + t_up[1] * a_t[1][c]);
         // r = A (t_N N + t_Tα ā^{αβ} T_β), assembled per node block
         let area = normal.area;
         let mut put = |i: usize, v: Dual| {

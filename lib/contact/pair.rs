@@ -363,14 +363,14 @@ impl PairSolver {
     }
 
     /// Appends the node group of every slave that needs a contact element now, and
-    /// its slave index to `owners`.
-    pub fn push_groups(&self, groups: &mut crate::assembly::NodeGroups, owners: &mut Vec<usize>) {
+    /// tells `owner` its slave index.
+    pub fn push_groups(&self, groups: &mut crate::assembly::NodeGroups, mut owner: impl FnMut(usize)) {
         for s in 0..self.slaves.len() {
             if !self.usable(s) || (self.projections[s].g >= self.capture && self.lambda_n[s] >= 0.0) {
                 continue;
             }
             groups.push_iter(std::iter::once(self.slaves[s]).chain(self.points[s].basis.nodes().iter().map(|&k| self.net[k])));
-            owners.push(s);
+            owner(s);
         }
     }
 

@@ -156,6 +156,13 @@ pub struct Increment {
     pub friction: Vec<Vec<[f64; 9]>>,
 }
 
+impl Increment {
+    /// The displacements as one dof vector (x, y, z of node 0, then node 1, …).
+    pub fn displacements(&self) -> Vec<f64> {
+        self.u.iter().flatten().copied().collect()
+    }
+}
+
 /// Where a restarted run came from: its first `increments` increments are those
 /// of `file`, the last at `load_factor`.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
@@ -244,7 +251,7 @@ impl Results {
         for (k, inc) in self.increments.iter().enumerate().skip(first) {
             let meta = SegmentMeta { increment: Some(inc.info.clone()), status: None };
             w.meta(&serde_yaml::to_string(&meta).expect("increment metadata serialises"));
-            let u: Vec<f64> = inc.u.iter().flatten().copied().collect();
+            let u = inc.displacements();
             w.f64s(&format!("inc/{k}/u"), &[n, 3], &u);
             let s: Vec<f64> = inc.stress.iter().flatten().flatten().copied().collect();
             w.f64s(&format!("inc/{k}/stress"), &[m, 8, 9], &s);

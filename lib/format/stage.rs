@@ -289,6 +289,10 @@ struct Cursor<'a> {
     bytes: &'a [u8],
     pos: usize,
     path: &'a str,
+    /// The checksum the current segment continues (the last `END!`'s) and where the
+    /// segment starts.
+    chain: u64,
+    segment_start: usize,
 }
 
 impl<'a> Cursor<'a> {
@@ -365,20 +369,17 @@ impl StageFile {
                 });
             }
         }
-        let mut c = Cursor { bytes, pos: header.len() + 1, path };
+        let mut c = Cursor { bytes, pos: header.len() + 1, path, chain: Checksum::new().0, segment_start: 0 };
         let mut meta = Vec::new();
         let mut arrays = Vec::new();
         let mut records = 0u64;
-        // the checksum the current segment continues, where it starts, and what the
-        // complete segments so far hold (records, META and array counts)
-        let (mut chain, mut segment_start) = (Checksum::new().0, 0usize);
-        let mut complete: Option<(u64, usize, usize)> = None;
+        // what the complete segments so far hold (META and array counts)
+        let mut complete: Option<(usize, usize)> = None;
         let result = loop {
-            let r = Self::record(&mut c, bytes, path, &mut meta, &mut arrays, records, &mut chain, &mut segment_start);
-            match r {
+            match Self::record(&mut c, &mut meta, &mut arrays, records) {
                 Ok(Record::Data) => records += 1,
                 Ok(Record::End) => {
-                    complete = Some((records, meta.len(), arrays.len()));
+                    complete = Some((meta.len(), arrays.len()));
                     if c.pos == bytes.len() {
                         break Ok(());
                     }
@@ -390,10 +391,11 @@ impl StageFile {
             (Ok(()), _) => None,
             (Err(e), None) => return Err(e),
             // a complete segment was read: what follows is an interrupted append
-            (Err(e), Some((_, n_meta, n_arrays))) => {
+            (Err(e), Some((n_meta, n_arrays))) => {
                 meta.truncate(n_meta);
                 arrays.truncate(n_arrays);
-                Some(format!("the {} bytes after byte {segment_start} are not a complete segment and were left out (an interrupted write?): {e}", bytes.len() - segment_start))
+                let start = c.segment_start;
+                Some(format!("the {} bytes after byte {start} are not a complete segment and were left out (an interrupted write?): {e}", bytes.len() - start))
             }
         };
         Ok(Self { path: path.to_string(), format, major, minor, meta, arrays, tail })
@@ -401,9 +403,8 @@ impl StageFile {
 
     /// Reads one record at the cursor: a META or ARRY (pushed), or an END! (checked
     /// against the record count and the chained checksum of its segment).
-    #[allow(clippy::too_many_arguments)]
-    fn record(c: &mut Cursor, bytes: &[u8], path: &str, meta: &mut Vec<String>, arrays: &mut Vec<Array>, records: u64, chain: &mut u64, segment_start: &mut usize) -> Result<Record, StageError> {
-        let at = c.pos;
+    fn record(c: &mut Cursor, meta: &mut Vec<String>, arrays: &mut Vec<Array>, records: u64) -> Result<Record, StageError> {
+        let (bytes, path, at) = (c.bytes, c.path, c.pos);
         let tag = c.take(4, "a record tag")?;
         match tag {
             b"META" => {
@@ -460,13 +461,13 @@ impl StageFile {
                 if count != records {
                     return Err(StageError::Corrupt { path: path.to_string(), offset: at as u64, what: format!("END says {count} records, found {records}") });
                 }
-                let mut ck = Checksum(*chain);
-                ck.update(&bytes[*segment_start..at]);
+                let mut ck = Checksum(c.chain);
+                ck.update(&bytes[c.segment_start..at]);
                 if ck.0 != sum {
                     return Err(StageError::Corrupt { path: path.to_string(), offset: at as u64, what: "checksum mismatch: the file was modified or damaged".into() });
                 }
-                *chain = sum;
-                *segment_start = c.pos;
+                c.chain = sum;
+                c.segment_start = c.pos;
                 return Ok(Record::End);
             }
             other => {

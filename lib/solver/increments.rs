@@ -17,7 +17,7 @@ use crate::format::sccontact::MasterKind;
 use crate::format::scres::{FrictionSummary, PairSummary};
 use crate::format::setup::Enforcement;
 use super::problem::Problem;
-use super::restart::RestartPoint;
+use super::restart::factors_done;
 use crate::assembly::DOFS_PER_NODE;
 use crate::fem::element::hex8_min_jacobian;
 use crate::format::scres::{Increment, IncrementInfo, Reaction, Results, ResultsFile, RunStatus};
@@ -42,7 +42,7 @@ pub enum SolveError {
     },
     #[error(transparent)]
     Write(#[from] StageError),
-    #[error("{file}: resuming from its last increment (load factor {load_factor:.6}): {failure}")]
+    #[error("{file}: resuming from its increment at load factor {load_factor:.6}: {failure}")]
     Resume { file: String, load_factor: f64, failure: IncrementFailure },
 }
 
@@ -51,9 +51,8 @@ pub struct SolveSummary {
     pub increments: usize,
     pub iterations: usize,
     pub cutbacks: u32,
-    /// Writing the results file: seconds (encode, write, sync) and bytes.
+    /// Writing the results file: seconds (encode, write, sync).
     pub write_seconds: f64,
-    pub write_bytes: u64,
 }
 
 /// Where the results go.
@@ -200,20 +199,25 @@ fn contact_results(newton: &Newton, u: &[f64]) -> ContactResults {
 }
 
 /// Run all increments; `results` holds the mesh and setup and receives the increments.
-/// With a restart point (whose increments `results` already holds) the solve continues
-/// from its last increment, with the load factors above it.
-pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &mut Results, out: &Outputs, log: &mut SolveLog, start: Option<&RestartPoint>) -> Result<SolveSummary, SolveError> {
+/// When it already holds some (a restart, `results.restart` says from where) the
+/// solve continues from the last of them, with the load factors above it.
+pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &mut Results, out: &Outputs, log: &mut SolveLog) -> Result<SolveSummary, SolveError> {
     let p: &Problem = newton.problem;
-    let (mut u, mut lambda_prev) = match start {
-        Some(point) => {
-            newton.resume(point).map_err(|failure| SolveError::Resume { file: point.file.display().to_string(), load_factor: point.load_factor(), failure })?;
-            (point.u(point.increments.len() - 1), point.load_factor())
+    let (mut u, mut lambda_prev) = match results.increments.last() {
+        Some(last) => {
+            let lambda = last.info.load_factor;
+            newton.resume(&results.increments).map_err(|failure| SolveError::Resume {
+                file: results.restart.as_ref().map_or_else(|| results.source.clone(), |o| o.file.clone()),
+                load_factor: lambda,
+                failure,
+            })?;
+            (last.displacements(), lambda)
         }
         None => (vec![0.0; DOFS_PER_NODE * p.n_nodes()], 0.0),
     };
-    let first = factors.len() - start.map_or(factors.len(), |point| point.remaining(factors));
+    let first = factors_done(factors, lambda_prev);
     let mut trial = u.clone();
-    let mut summary = SolveSummary { increments: 0, iterations: 0, cutbacks: 0, write_seconds: 0.0, write_bytes: 0 };
+    let mut summary = SolveSummary { increments: 0, iterations: 0, cutbacks: 0, write_seconds: 0.0 };
     let mut file = ResultsFile::new(out.results);
     let n_inc = factors.len();
     for (k, &target) in factors.iter().enumerate().skip(first) {
@@ -320,7 +324,7 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
     results.status = RunStatus::Completed;
     write(&mut file, results, out, log)?;
     log.line(&format!("results: {} increments, {:.1} MB written to {} in {:.2} s", results.increments.len(), file.bytes as f64 / 1e6, out.results.display(), file.seconds));
-    (summary.write_seconds, summary.write_bytes) = (file.seconds, file.bytes);
+    summary.write_seconds = file.seconds;
     Ok(summary)
 }
 

@@ -16,14 +16,13 @@ use std::time::Instant;
 use nalgebra::{DMatrix, DVector, Vector3};
 
 use super::problem::Problem;
-use super::restart::RestartPoint;
 use super::stabilization::Stabilization;
 use crate::assembly::{Assembly, AssemblyError, ElementFailure, NodeGroups, Pattern, PatternError, DOFS_PER_NODE};
 use crate::contact::element::ContactElementError;
 use crate::contact::pair::{PairError, PairSolver};
 use crate::fem::element::{hex8_gauss_stresses, hex8_residual_tangent, ElementError};
 use crate::fem::pressure::{follower_pressure_force_stiffness, FaceMatrix, FaceVector};
-use crate::format::scres::IterationLog;
+use crate::format::scres::{Increment, IterationLog};
 use crate::format::setup::{LinearSolverChoice, NewtonSetup};
 use crate::solver::linear::{FaerDirect, FaerDirectOptions, LinearSolver, LinearSolverError, SymmetricStrategy, Symmetry};
 
@@ -104,9 +103,8 @@ pub struct Newton<'p> {
     /// Owner of every group of `pattern`.
     owners: Vec<GroupOwner>,
     /// The contact search's groups, compared with the pattern's every iteration
-    /// (storage reused), and the scratch list of a pair's slaves with a group.
+    /// (storage reused).
     group_scratch: NodeGroups,
-    slave_scratch: Vec<usize>,
     /// Times the pattern was rebuilt because contact groups changed.
     pub pattern_rebuilds: u32,
     /// The symmetry the linear solver was set up for.
@@ -133,8 +131,8 @@ impl<'p> Newton<'p> {
         for def in &problem.contact {
             contact.push(PairSolver::new(def, &problem.X)?);
         }
-        let (mut owners, mut groups, mut slave_scratch) = (Vec::new(), NodeGroups::new(), Vec::new());
-        contact_groups(problem, &mut contact, &vec![0.0; DOFS_PER_NODE * problem.n_nodes()], &mut groups, &mut owners, &mut slave_scratch)?;
+        let (mut owners, mut groups) = (Vec::new(), NodeGroups::new());
+        contact_groups(problem, &mut contact, &vec![0.0; DOFS_PER_NODE * problem.n_nodes()], &mut groups, &mut owners)?;
         for pair in &mut contact {
             pair.init_history();
         }
@@ -168,7 +166,6 @@ impl<'p> Newton<'p> {
             contact,
             owners,
             group_scratch: NodeGroups::new(),
-            slave_scratch,
             pattern_rebuilds: 0,
             symmetry,
             step_halvings: 0,
@@ -186,7 +183,7 @@ impl<'p> Newton<'p> {
         }
         let fail = |message: String| IncrementFailure::ContactSetup { iteration, message };
         let mut groups = std::mem::take(&mut self.group_scratch);
-        contact_groups(self.problem, &mut self.contact, u, &mut groups, &mut self.owners, &mut self.slave_scratch).map_err(|e| fail(e.to_string()))?;
+        contact_groups(self.problem, &mut self.contact, u, &mut groups, &mut self.owners).map_err(|e| fail(e.to_string()))?;
         if &groups == self.pattern.groups() {
             self.group_scratch = groups;
         } else {
@@ -239,18 +236,19 @@ impl<'p> Newton<'p> {
     /// takes the last two states (its extrapolation), every pair its multipliers and
     /// friction history, and the contact search runs at the last state, so the next
     /// increment starts where the interrupted run would have.
-    pub fn resume(&mut self, point: &RestartPoint) -> Result<(), IncrementFailure> {
-        let n = point.increments.len();
-        for k in n.saturating_sub(2)..n {
-            self.commit_increment(&point.u(k), point.increments[k].info.load_factor);
+    /// `increments` are the converged ones read back (at least one).
+    pub fn resume(&mut self, increments: &[Increment]) -> Result<(), IncrementFailure> {
+        let tail = &increments[increments.len().saturating_sub(2)..];
+        for inc in tail {
+            self.commit_increment(&inc.displacements(), inc.info.load_factor);
         }
-        let last = point.last();
+        let Some(last) = tail.last() else { return Ok(()) };
         for (p, pair) in self.contact.iter_mut().enumerate() {
             let state = last.contact.get(p).map_or(&[][..], |s| &s[..]);
             let friction = last.friction.get(p).map_or(&[][..], |f| &f[..]);
             pair.restore_history(state, friction);
         }
-        self.contact_search(&point.u(n - 1), 0)
+        self.contact_search(&last.displacements(), 0)
     }
 
     /// The stabilisation force ‖f‖ on each pair's master net at `u` (0 for a pair
@@ -547,8 +545,8 @@ enum AssemblyFailure {
 
 /// Contact search of every pair at `u` and the node groups of the pattern into
 /// `groups`: the follower-pressure faces, then every contact element; `owners` says
-/// which is which. (`slaves` is scratch; all three keep their storage between calls.)
-fn contact_groups(p: &Problem, contact: &mut [PairSolver], u: &[f64], groups: &mut NodeGroups, owners: &mut Vec<GroupOwner>, slaves: &mut Vec<usize>) -> Result<(), PairError> {
+/// which is which. (Both keep their storage between calls.)
+fn contact_groups(p: &Problem, contact: &mut [PairSolver], u: &[f64], groups: &mut NodeGroups, owners: &mut Vec<GroupOwner>) -> Result<(), PairError> {
     groups.clear();
     for f in &p.pressure_faces {
         groups.push(&f.nodes);
@@ -560,9 +558,7 @@ fn contact_groups(p: &Problem, contact: &mut [PairSolver], u: &[f64], groups: &m
             let d = DOFS_PER_NODE * n as usize;
             p.X[n as usize] + Vector3::new(u[d], u[d + 1], u[d + 2])
         })?;
-        slaves.clear();
-        pair.push_groups(groups, slaves);
-        owners.extend(slaves.iter().map(|&s| GroupOwner::Contact(k, s)));
+        pair.push_groups(groups, |s| owners.push(GroupOwner::Contact(k, s)));
     }
     Ok(())
 }

@@ -21,7 +21,6 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::assembly::DOFS_PER_NODE;
 use crate::format::sccontact::ContactPair;
 use crate::format::scres::{Increment, Results};
 use crate::format::stage::StageError;
@@ -115,16 +114,27 @@ impl RestartPoint {
         self.last().info.load_factor
     }
 
-    /// Displacements of increment `k` as a flat dof vector.
-    pub fn u(&self, k: usize) -> Vec<f64> {
-        let mut u = Vec::with_capacity(DOFS_PER_NODE * self.increments[k].u.len());
-        u.extend(self.increments[k].u.iter().flatten());
-        u
-    }
-
-    /// The load factors of `factors` still to solve (those above the restart's).
+    /// How many of the load factors `factors` are still to solve.
     pub fn remaining(&self, factors: &[f64]) -> usize {
-        let done = self.load_factor();
-        factors.iter().filter(|&&f| f > done + 1e-12 * f.abs().max(1.0)).count()
+        factors.len() - factors_done(factors, self.load_factor())
     }
+}
+
+/// Load factors this close (1e-12 relative, or absolute below 1) are the same: a
+/// factor the setup recomputes is the one a results file stored.
+fn same(a: f64, b: f64) -> bool {
+    (a - b).abs() <= 1e-12 * a.abs().max(1.0)
+}
+
+/// How many of the (increasing) load factors `factors` a run that converged at
+/// `lambda` has done.
+pub fn factors_done(factors: &[f64], lambda: f64) -> usize {
+    factors.iter().filter(|&&f| f < lambda || same(f, lambda)).count()
+}
+
+/// The number (1-based, as the solve log counts them) of the load factor an increment
+/// converged at `lambda` belongs to: the first it does not pass (a cut-back step
+/// counts toward the factor it was aiming at).
+pub fn increment_number(factors: &[f64], lambda: f64) -> usize {
+    (factors.iter().filter(|&&f| f < lambda && !same(f, lambda)).count() + 1).min(factors.len())
 }

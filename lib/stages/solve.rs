@@ -14,7 +14,7 @@ use crate::solver::increments::{self, Outputs};
 use crate::solver::log::{SolveLog, Verbosity};
 use crate::solver::newton::Newton;
 use crate::solver::problem::Problem;
-use crate::solver::restart::RestartPoint;
+use crate::solver::restart::{increment_number, RestartPoint};
 
 /// Where a solve restarts: a results file and, optionally, which of its converged
 /// increments (1-based; default its last).
@@ -119,14 +119,11 @@ pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, 
         restart: None,
         tail: None,
     };
-    if let Some(point) = &point {
+    if let Some(point) = point {
         // the restart file's increments open the history, and its iterations the CSV
         for inc in &point.increments {
-            let lambda = inc.info.load_factor;
-            let number = factors.iter().position(|&f| f >= lambda - 1e-12 * f.abs().max(1.0)).unwrap_or(factors.len() - 1) + 1;
-            log.restored(number, factors.len(), &inc.info);
+            log.restored(increment_number(&factors, inc.info.load_factor), factors.len(), &inc.info);
         }
-        results.increments = point.increments.clone();
         results.restart = Some(RestartOrigin { file: point.file.display().to_string(), increments: point.increments.len() as u32, load_factor: point.load_factor() });
         log.line(&format!(
             "restart from {}: {} converged increments, continuing from load factor {:.6} ({} of the setup's {} increments left){}",
@@ -137,10 +134,11 @@ pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, 
             factors.len(),
             point.tail.as_ref().map_or(String::new(), |t| format!("; warning: {t}"))
         ));
+        results.increments = point.increments;
     }
     let forces = output.with_extension("forces.csv");
     let outputs = Outputs { results: output, csv, forces_csv: Some(&forces) };
-    let summary = increments::solve(&mut newton, &factors, setup.increments.max_cutbacks, &mut results, &outputs, &mut log, point.as_ref());
+    let summary = increments::solve(&mut newton, &factors, setup.increments.max_cutbacks, &mut results, &outputs, &mut log);
     if !newton.contact.is_empty() {
         log.line(&format!("contact: the sparsity pattern was rebuilt {} times as contact elements changed", newton.pattern_rebuilds));
     }
