@@ -72,12 +72,7 @@ fn stopped_solve_keeps_converged_increments() {
 /// The shipped cantilever pipeline: import, solve, export; meshio reads every step.
 #[test]
 fn cantilever_pipeline_results_open_in_meshio() {
-    let dir = tempdir();
-    for sub in ["meshes", "pipelines"] {
-        std::fs::create_dir_all(dir.path().join(sub)).unwrap();
-    }
-    std::fs::copy(repo().join("meshes/cantilever.msh"), dir.path().join("meshes/cantilever.msh")).unwrap();
-    std::fs::copy(repo().join("pipelines/cantilever.yaml"), dir.path().join("pipelines/cantilever.yaml")).unwrap();
+    let dir = staged_pipeline("cantilever", &["cantilever.msh"]);
     let o = run("sc-pipeline", &["pipelines/cantilever.yaml"], dir.path());
     assert!(o.status.success(), "{}", stderr(&o));
     let pvd = dir.path().join("pipelines/out/cantilever.pvd");
@@ -156,13 +151,8 @@ fn restart_from_another_model_is_refused() {
 #[test]
 fn pipeline_solve_stage_restarts() {
     use splinecontact::format::scres::Results;
-    let dir = tempdir();
-    for sub in ["meshes", "pipelines"] {
-        std::fs::create_dir_all(dir.path().join(sub)).unwrap();
-    }
-    std::fs::copy(repo().join("meshes/cantilever.msh"), dir.path().join("meshes/cantilever.msh")).unwrap();
+    let dir = staged_pipeline("cantilever", &["cantilever.msh"]);
     let first = std::fs::read_to_string(repo().join("pipelines/cantilever.yaml")).unwrap();
-    std::fs::write(dir.path().join("pipelines/cantilever.yaml"), &first).unwrap();
     let o = run("sc-pipeline", &["pipelines/cantilever.yaml", "-q"], dir.path());
     assert!(o.status.success(), "{}", stderr(&o));
     let more = first

@@ -89,3 +89,25 @@ pub fn python_script(script: &str, args: &[&Path]) -> Output {
 pub fn tempdir() -> tempfile::TempDir {
     tempfile::tempdir().expect("temp dir")
 }
+
+/// A scratch copy of the repository layout for running a pipeline without writing
+/// into the checkout: `meshes/` with the named meshes of the repository, and an
+/// empty `pipelines/` to put the pipeline in.
+pub fn staged_meshes(meshes: &[&str]) -> tempfile::TempDir {
+    let dir = tempdir();
+    for d in ["meshes", "pipelines"] {
+        std::fs::create_dir_all(dir.path().join(d)).unwrap();
+    }
+    for m in meshes {
+        std::fs::copy(repo().join("meshes").join(m), dir.path().join("meshes").join(m)).unwrap();
+    }
+    dir
+}
+
+/// [`staged_meshes`], plus the shipped `pipelines/<name>.yaml`.
+pub fn staged_pipeline(name: &str, meshes: &[&str]) -> tempfile::TempDir {
+    let dir = staged_meshes(meshes);
+    let yaml = format!("pipelines/{name}.yaml");
+    std::fs::copy(repo().join(&yaml), dir.path().join(&yaml)).unwrap();
+    dir
+}

@@ -6,17 +6,11 @@
 
 use std::path::Path;
 
-use crate::common::{python_script, repo, run, stderr, tempdir};
+use crate::common::{python_script, repo, run, stderr, staged_meshes, tempdir};
 use splinecontact::format::scres::Results;
 
 fn staged(pipeline: &str) -> tempfile::TempDir {
-    let dir = tempdir();
-    for d in ["meshes", "pipelines"] {
-        std::fs::create_dir_all(dir.path().join(d)).unwrap();
-    }
-    for m in ["hertz.msh", "curved.msh", "curved-nby3.msh"] {
-        std::fs::copy(repo().join("meshes").join(m), dir.path().join("meshes").join(m)).unwrap();
-    }
+    let dir = staged_meshes(&["hertz.msh", "curved.msh", "curved-nby3.msh"]);
     std::fs::copy(repo().join("pipelines").join(pipeline), dir.path().join("pipelines").join(pipeline)).unwrap();
     let o = run("sc-pipeline", &[&format!("pipelines/{pipeline}")], dir.path());
     assert!(o.status.success(), "{pipeline}: {}", stderr(&o));

@@ -11,7 +11,7 @@ use splinecontact::format::scres::{Results, RunStatus};
 use splinecontact::post::oscillation::oscillation;
 
 use super::sliding::{history, newton_and_cutbacks, History};
-use crate::common::{repo, run, stderr, tempdir};
+use crate::common::{run, stderr, staged_pipeline};
 
 /// The die slides 4 over t ∈ [0.2, 1.2]; the slab's element length along x is 9 / 20.
 const TRAVEL: f64 = 4.0;
@@ -32,12 +32,7 @@ fn h_ripple(h: &History) -> f64 {
 /// Run a shipped pipeline in a copy of meshes/ and pipelines/; the histories and
 /// results of its three masters.
 fn run_ironing(name: &str) -> (tempfile::TempDir, Vec<(&'static str, History, Results)>) {
-    let dir = tempdir();
-    for d in ["meshes", "pipelines"] {
-        std::fs::create_dir_all(dir.path().join(d)).unwrap();
-    }
-    std::fs::copy(repo().join("meshes/ironing3d.msh"), dir.path().join("meshes/ironing3d.msh")).unwrap();
-    std::fs::copy(repo().join(format!("pipelines/{name}.yaml")), dir.path().join(format!("pipelines/{name}.yaml"))).unwrap();
+    let dir = staged_pipeline(name, &["ironing3d.msh"]);
     let o = run("sc-pipeline", &["-q", &format!("pipelines/{name}.yaml")], dir.path());
     assert!(o.status.success(), "{name}: {}", stderr(&o));
     let out = dir.path().join("pipelines/out");

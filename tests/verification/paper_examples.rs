@@ -5,16 +5,11 @@
 
 use splinecontact::format::scres::{Results, RunStatus};
 
-use crate::common::{repo, run, stderr, tempdir};
+use crate::common::{repo, run, stderr, staged_meshes, staged_pipeline};
 
 /// Run `pipelines/<name>.yaml` in a copy of meshes/ and pipelines/.
 fn run_pipeline(name: &str) -> Results {
-    let dir = tempdir();
-    for d in ["meshes", "pipelines"] {
-        std::fs::create_dir_all(dir.path().join(d)).unwrap();
-    }
-    std::fs::copy(repo().join(format!("meshes/{name}.msh")), dir.path().join(format!("meshes/{name}.msh"))).unwrap();
-    std::fs::copy(repo().join(format!("pipelines/{name}.yaml")), dir.path().join(format!("pipelines/{name}.yaml"))).unwrap();
+    let dir = staged_pipeline(name, &[&format!("{name}.msh")]);
     let o = run("sc-pipeline", &[&format!("pipelines/{name}.yaml")], dir.path());
     assert!(o.status.success(), "{name}: {}", stderr(&o));
     Results::read(&dir.path().join(format!("pipelines/out/{name}.scres"))).unwrap()
@@ -76,11 +71,7 @@ fn paper_examples_are_pinned() {
 fn default_penalty_reproduces_the_paper_examples() {
     let pins = [("crossed_beams", 1.11427661), ("parallel_beams", 0.33898814), ("supported_beam", 0.79809336)];
     for (name, u_pin) in pins {
-        let dir = tempdir();
-        for d in ["meshes", "pipelines"] {
-            std::fs::create_dir_all(dir.path().join(d)).unwrap();
-        }
-        std::fs::copy(repo().join(format!("meshes/{name}.msh")), dir.path().join(format!("meshes/{name}.msh"))).unwrap();
+        let dir = staged_meshes(&[&format!("{name}.msh")]);
         let yaml = std::fs::read_to_string(repo().join(format!("pipelines/{name}.yaml"))).unwrap();
         // drop the penalties from the contact entry
         let stripped: String = yaml

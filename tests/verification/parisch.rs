@@ -9,7 +9,7 @@ use splinecontact::format::setup::{Enforcement, ModelName, SolveSetup};
 use splinecontact::format::msh;
 
 use super::contact::{pair, run_contact};
-use crate::common::{python_script, repo, run, stderr, tempdir};
+use crate::common::{python_script, repo, run, stderr, staged_pipeline};
 
 /// CalculiX, penalty K = 1e5: load-node u_z (7 significant digits in its .dat).
 const CCX_UZ_PENALTY: f64 = -5.028827e-2;
@@ -47,12 +47,7 @@ fn parisch_mesh() -> splinecontact::mesh::Mesh {
 /// (below 1e-5); measured 7.0e-6.
 #[test]
 fn parisch_pipeline_matches_calculix() {
-    let dir = tempdir();
-    for d in ["meshes", "pipelines"] {
-        std::fs::create_dir_all(dir.path().join(d)).unwrap();
-    }
-    std::fs::copy(repo().join("meshes/parisch.msh"), dir.path().join("meshes/parisch.msh")).unwrap();
-    std::fs::copy(repo().join("pipelines/parisch.yaml"), dir.path().join("pipelines/parisch.yaml")).unwrap();
+    let dir = staged_pipeline("parisch", &["parisch.msh"]);
     let o = run("sc-pipeline", &["pipelines/parisch.yaml"], dir.path());
     assert!(o.status.success(), "{}", stderr(&o));
     let r = Results::read(&dir.path().join("pipelines/out/parisch.scres")).unwrap();

@@ -18,7 +18,7 @@ use splinecontact::format::scres::{Results, RunStatus};
 use splinecontact::post::oscillation::oscillation;
 
 use super::sliding::{history, newton_and_cutbacks, History};
-use crate::common::{repo, run, stderr, tempdir};
+use crate::common::{repo, run, stderr, staged_meshes};
 
 /// The indenter slides 10 over t ∈ [1, 2]; the foundation's element length along x is 12 / 60.
 const SLIDE: f64 = 10.0;
@@ -73,11 +73,7 @@ fn solve(name: &str, chain: &str) -> (History, Results) {
 /// Runs `pipeline` (derived from `name`, solving its `chain`) in a scratch copy.
 fn solve_pipeline(name: &str, chain: &str, pipeline: &str) -> (History, Results) {
     let stem = format!("{name}-{chain}");
-    let dir = tempdir();
-    for d in ["meshes", "pipelines"] {
-        std::fs::create_dir_all(dir.path().join(d)).unwrap();
-    }
-    std::fs::copy(repo().join("meshes/shallow_ironing.msh"), dir.path().join("meshes/shallow_ironing.msh")).unwrap();
+    let dir = staged_meshes(&["shallow_ironing.msh"]);
     std::fs::write(dir.path().join("pipelines/test.yaml"), pipeline).unwrap();
     let o = run("sc-pipeline", &["-q", "pipelines/test.yaml"], dir.path());
     assert!(o.status.success(), "{name}: {}", stderr(&o));
