@@ -16,6 +16,17 @@ fn imported_cantilever(dir: &Path) {
 
 const GOOD: &str = "materials: [{body: beam, model: neo_hookean, E: 1000.0, nu: 0.3}]\nconstraints: [{set: clamped, fix: [x, y, z]}]\nloads: [{set: tip, force: [0, 0, -1.0]}]\nincrements: {count: 5}\n";
 
+/// The cantilever imported and solved with [`GOOD`] into `r.scres`, in a scratch
+/// folder.
+fn solved_cantilever() -> tempfile::TempDir {
+    let dir = tempdir();
+    imported_cantilever(dir.path());
+    write_setup(dir.path(), GOOD);
+    let o = run("sc-solve", &["c.scmesh", "--setup", "setup.yaml", "-o", "r.scres", "-q"], dir.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    dir
+}
+
 fn solve_fails(setup: &str, needles: &[&str]) {
     let dir = tempdir();
     imported_cantilever(dir.path());
@@ -132,11 +143,7 @@ fn restart_continues_a_stopped_solve_into_its_own_file() {
 /// nothing written.
 #[test]
 fn restart_from_another_model_is_refused() {
-    let dir = tempdir();
-    imported_cantilever(dir.path());
-    write_setup(dir.path(), GOOD);
-    let o = run("sc-solve", &["c.scmesh", "--setup", "setup.yaml", "-o", "r.scres", "-q"], dir.path());
-    assert!(o.status.success(), "{}", stderr(&o));
+    let dir = solved_cantilever();
     let o = run("sc-import", &[repo().join("meshes/parisch.msh").to_str().unwrap(), "-o", "p.scmesh", "-q"], dir.path());
     assert!(o.status.success(), "{}", stderr(&o));
     let o = run("sc-solve", &["p.scmesh", "--setup", "setup.yaml", "-o", "p.scres", "--restart", "r.scres"], dir.path());
@@ -212,11 +219,7 @@ fn results_file_appends_and_survives_a_cut_append() {
 #[test]
 fn restart_from_an_earlier_increment() {
     use splinecontact::format::scres::Results;
-    let dir = tempdir();
-    imported_cantilever(dir.path());
-    write_setup(dir.path(), GOOD);
-    let o = run("sc-solve", &["c.scmesh", "--setup", "setup.yaml", "-o", "r.scres", "-q"], dir.path());
-    assert!(o.status.success(), "{}", stderr(&o));
+    let dir = solved_cantilever();
     write_setup(dir.path(), &GOOD.replace("increments: {count: 5}", "increments: {count: 10}"));
     let o = run("sc-solve", &["c.scmesh", "--setup", "setup.yaml", "-o", "redo.scres", "--restart", "r.scres", "--restart-increment", "2"], dir.path());
     let err = stderr(&o);
