@@ -40,12 +40,13 @@ struct Args {
 fn main() -> ExitCode {
     let args = Args::parse();
     match export::export(&args.input, &args.output, args.format) {
-        Ok(msg) => {
+        Ok(exported) => {
             if !args.quiet && args.output.as_os_str() != "-" {
-                eprintln!("{msg}");
-            } else if let Some(warning) = msg.lines().find(|l| l.starts_with("warning: ")) {
-                // an incomplete results file is said even when quiet
-                eprintln!("sc-export: {warning}");
+                eprintln!("{}", exported.written);
+            }
+            // an incomplete results file is said even when quiet
+            for warning in &exported.warnings {
+                eprintln!("sc-export: warning: {warning}");
             }
             ExitCode::SUCCESS
         }

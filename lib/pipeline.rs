@@ -100,8 +100,11 @@ pub fn run(path: &Path, verbosity: Verbosity, log: &mut dyn FnMut(&str)) -> Resu
                 let (input, out) = (resolve(&base, &s.input), resolve(&base, &s.output));
                 log(&format!("[{index}/{n}] export {} -> {}", input.display(), out.display()));
                 ensure_parent(&out).map_err(fail)?;
-                let msg = stages::export::export(&input, &out, s.format).map_err(fail)?;
-                log(&format!("      {msg}"));
+                let exported = stages::export::export(&input, &out, s.format).map_err(fail)?;
+                log(&format!("      {}", exported.written));
+                for warning in &exported.warnings {
+                    log(&format!("      warning: {warning}"));
+                }
             }
             Stage::Plot(s) => {
                 let out = resolve(&base, &s.output);

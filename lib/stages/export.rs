@@ -34,9 +34,24 @@ impl ExportFormat {
     }
 }
 
+/// What an export wrote, and what the user must hear about it even when quiet.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Exported {
+    /// One line describing what was written.
+    pub written: String,
+    /// What was read but could not be exported: an incomplete results file names the
+    /// bytes it left out (`Results::tail`), each warning naming the input file.
+    pub warnings: Vec<String>,
+}
+
+impl From<String> for Exported {
+    fn from(written: String) -> Self {
+        Self { written, warnings: Vec::new() }
+    }
+}
+
 /// Export `input` to `output` in `format` (or the one implied by the extension).
-/// Returns one line describing what was written.
-pub fn export(input: &Path, output: &Path, format: Option<ExportFormat>) -> Result<String, StageRunError> {
+pub fn export(input: &Path, output: &Path, format: Option<ExportFormat>) -> Result<Exported, StageRunError> {
     let format = match format.or_else(|| ExportFormat::from_extension(output)) {
         Some(f) => f,
         None => {
@@ -50,18 +65,18 @@ pub fn export(input: &Path, output: &Path, format: Option<ExportFormat>) -> Resu
     match format {
         ExportFormat::Yaml => {
             write_atomic_with(output, |w| file.dump_yaml(w))?;
-            Ok(format!("wrote {} ({} {}.{} as YAML)", output.display(), file.format, file.major, file.minor))
+            Ok(format!("wrote {} ({} {}.{} as YAML)", output.display(), file.format, file.major, file.minor).into())
         }
         ExportFormat::Vtu => match file.format.as_str() {
             scmesh::FORMAT => {
                 let mesh = scmesh::from_stage(&file)?;
                 let (n, m) = (mesh.nodes.len(), mesh.hexes.len());
                 vtk::mesh_grid(&mesh).write_vtu(output)?;
-                Ok(format!("wrote {} ({n} points, {m} hexahedra)", output.display()))
+                Ok(format!("wrote {} ({n} points, {m} hexahedra)", output.display()).into())
             }
             sccontact::FORMAT => {
                 let model = ContactModel::from_stage(&file)?;
-                write_contact_vtu(&model, output)
+                write_contact_vtu(&model, output).map(Exported::from)
             }
             other => Err(StageRunError::Usage(format!("{}: a '{other}' file cannot be exported as .vtu (supported: scmesh, sccontact)", input.display()))),
         },
@@ -69,10 +84,8 @@ pub fn export(input: &Path, output: &Path, format: Option<ExportFormat>) -> Resu
             scres::FORMAT => {
                 let results = Results::from_stage(&file)?;
                 let written = write_results_pvd(&results, output)?;
-                Ok(match &results.tail {
-                    Some(t) => format!("{written}\nwarning: {}: {t}", input.display()),
-                    None => written,
-                })
+                let warnings = results.tail.iter().map(|t| format!("{}: {t}", input.display())).collect();
+                Ok(Exported { written, warnings })
             }
             other => Err(StageRunError::Usage(format!(
                 "{}: a '{other}' file holds no time series; .pvd is written for results files (use .vtu for a mesh)",

@@ -206,6 +206,13 @@ fn results_file_appends_and_survives_a_cut_append() {
     assert!(cut.increments.iter().zip(&r.increments).all(|(a, b)| a.u == b.u));
     let o = run("sc-export", &["cut.scres", "-o", "cut.pvd", "-q"], dir.path());
     assert!(o.status.success() && stderr(&o).contains("warning: cut.scres: the") && stderr(&o).contains("left out"), "{}", stderr(&o));
+    // the library says it as a warning of its own, not inside the line of what it wrote
+    use splinecontact::stages::export::export;
+    let cut_export = export(&dir.path().join("cut.scres"), &dir.path().join("cut2.pvd"), None).unwrap();
+    assert!(cut_export.warnings.len() == 1 && cut_export.warnings[0].contains("cut.scres: the"), "{cut_export:?}");
+    assert!(!cut_export.written.contains("warning"), "{cut_export:?}");
+    let whole_export = export(&dir.path().join("r.scres"), &dir.path().join("r.pvd"), None).unwrap();
+    assert!(whole_export.warnings.is_empty(), "{whole_export:?}");
     let o = run("sc-solve", &["c.scmesh", "--setup", "setup.yaml", "-o", "cut.scres", "--restart", "cut.scres", "-q"], dir.path());
     assert!(o.status.success(), "{}", stderr(&o));
     let healed = Results::read(&dir.path().join("cut.scres")).unwrap();
