@@ -32,7 +32,7 @@ struct Args {
     /// Output format (default: from the output's extension).
     #[arg(short, long, value_enum)]
     format: Option<ExportFormat>,
-    /// Print nothing but errors.
+    /// Print nothing but warnings and errors.
     #[arg(short, long)]
     quiet: bool,
 }

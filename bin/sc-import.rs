@@ -24,7 +24,7 @@ struct Args {
     /// Output .scmesh file, or - for standard output.
     #[arg(short, long)]
     output: PathBuf,
-    /// Print nothing but errors.
+    /// Print nothing but warnings and errors.
     #[arg(short, long)]
     quiet: bool,
 }
@@ -40,6 +40,9 @@ fn main() -> ExitCode {
                 if args.output.as_os_str() != "-" {
                     eprintln!("wrote {}", args.output.display());
                 }
+            }
+            for warning in &report.warnings {
+                eprintln!("sc-import: warning: {warning}");
             }
             ExitCode::SUCCESS
         }

@@ -20,7 +20,7 @@ use clap::Parser;
 struct Args {
     /// The pipeline YAML file.
     pipeline: PathBuf,
-    /// Print nothing but errors.
+    /// Print nothing but warnings and errors.
     #[arg(short, long)]
     quiet: bool,
 }
@@ -34,7 +34,9 @@ fn main() -> ExitCode {
         }
     };
     let verbosity = if quiet { splinecontact::solver::log::Verbosity::Quiet } else { splinecontact::solver::log::Verbosity::Normal };
-    match splinecontact::pipeline::run(&args.pipeline, verbosity, &mut log) {
+    // warnings are said even when quiet
+    let mut warn = |line: &str| eprintln!("warning: {line}");
+    match splinecontact::pipeline::run(&args.pipeline, verbosity, &mut log, &mut warn) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("sc-pipeline: error: {e}");

@@ -72,7 +72,7 @@ struct Args {
     /// increments after it are not carried over.
     #[arg(long, value_name = "K", requires = "restart")]
     restart_increment: Option<usize>,
-    /// Print nothing but errors.
+    /// Print nothing but warnings and errors.
     #[arg(short, long)]
     quiet: bool,
 }

@@ -35,8 +35,10 @@ fn ensure_parent(p: &Path) -> Result<(), StageRunError> {
     }
 }
 
-/// Run every stage of the pipeline at `path`; `log` receives one line per event.
-pub fn run(path: &Path, verbosity: Verbosity, log: &mut dyn FnMut(&str)) -> Result<(), RunError> {
+/// Run every stage of the pipeline at `path`; `log` receives one line per event, and
+/// `warn` each warning of the import and export stages (a warning names its file; the
+/// solve stage prints its own through its log at `verbosity`).
+pub fn run(path: &Path, verbosity: Verbosity, log: &mut dyn FnMut(&str), warn: &mut dyn FnMut(&str)) -> Result<(), RunError> {
     let pipeline = Pipeline::read(path)?;
     let base: PathBuf = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let n = pipeline.stages.len();
@@ -60,6 +62,9 @@ pub fn run(path: &Path, verbosity: Verbosity, log: &mut dyn FnMut(&str)) -> Resu
                 let (mesh, report) = stages::import::import(&input, &out).map_err(fail)?;
                 for line in stages::import::summary(&input, &mesh, &report) {
                     log(&format!("      {line}"));
+                }
+                for w in &report.warnings {
+                    warn(w);
                 }
             }
             Stage::Tag(s) => {
@@ -102,8 +107,8 @@ pub fn run(path: &Path, verbosity: Verbosity, log: &mut dyn FnMut(&str)) -> Resu
                 ensure_parent(&out).map_err(fail)?;
                 let exported = stages::export::export(&input, &out, s.format).map_err(fail)?;
                 log(&format!("      {}", exported.written));
-                for warning in &exported.warnings {
-                    log(&format!("      warning: {warning}"));
+                for w in &exported.warnings {
+                    warn(w);
                 }
             }
             Stage::Plot(s) => {

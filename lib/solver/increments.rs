@@ -254,8 +254,8 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
                     let (summaries, states, friction) = contact_results(newton, &u);
                     for c in &newton.contact {
                         if let (n, Some(node)) = c.failed_projections() {
-                            log.line(&format!(
-                                "increment {}/{n_inc}: warning: pair '{}': the closest-point projection failed for {n} slave nodes (first: node {}); they are treated as out of contact",
+                            log.warning(&format!(
+                                "increment {}/{n_inc}: pair '{}': the closest-point projection failed for {n} slave nodes (first: node {}); they are treated as out of contact",
                                 k + 1,
                                 c.name,
                                 p.node_tags.get(node as usize).copied().unwrap_or(node as u64)
@@ -268,8 +268,8 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
                             log.line(&format!("increment {}/{n_inc}: pair '{}': stabilisation force {:.3e} on the master surface (contact force {:.3e})", k + 1, s.pair, s.stabilization_force, f));
                         }
                         if !s.penetration_converged {
-                            log.line(&format!(
-                                "increment {}/{n_inc}: warning: pair '{}' still penetrates {:.3e} after {} augmentations (raise max_augmentations or eps_n)",
+                            log.warning(&format!(
+                                "increment {}/{n_inc}: pair '{}' still penetrates {:.3e} after {} augmentations (raise max_augmentations or eps_n)",
                                 k + 1,
                                 s.pair,
                                 s.max_penetration,

@@ -81,6 +81,16 @@ impl SolveLog {
         if self.verbosity == Verbosity::Quiet {
             return;
         }
+        self.print(text);
+    }
+
+    /// A warning: printed as `warning: <text>` even when quiet, since it says the
+    /// answer is not what was asked for (penetration above tolerance, nodes left out).
+    pub fn warning(&self, text: &str) {
+        self.print(&format!("warning: {text}"));
+    }
+
+    fn print(&self, text: &str) {
         match &self.bar {
             Some(b) => b.println(text),
             None => {

@@ -126,14 +126,16 @@ pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, 
         }
         results.restart = Some(RestartOrigin { file: point.file.display().to_string(), increments: point.increments.len() as u32, load_factor: point.load_factor() });
         log.line(&format!(
-            "restart from {}: {} converged increments, continuing from load factor {:.6} ({} of the setup's {} increments left){}",
+            "restart from {}: {} converged increments, continuing from load factor {:.6} ({} of the setup's {} increments left)",
             point.file.display(),
             point.increments.len(),
             point.load_factor(),
             point.remaining(&factors),
             factors.len(),
-            point.tail.as_ref().map_or(String::new(), |t| format!("; warning: {t}"))
         ));
+        if let Some(t) = &point.tail {
+            log.warning(&format!("{}: {t}", point.file.display()));
+        }
         results.increments = point.increments;
     }
     let forces = output.with_extension("forces.csv");

@@ -111,3 +111,36 @@ fn every_shipped_pipeline_parses_and_finds_its_meshes() {
     }
     assert!(n >= 13, "found {n} pipelines");
 }
+
+/// Warnings are said even with `-q` (which silences everything else): an import
+/// warning (an unknown MSH section, skipped), a solver warning (the augmented
+/// Lagrangian allowed one update against a tolerance it cannot reach) and an export
+/// warning (the sc-export test in `solve.rs`); each names its file or pair.
+#[test]
+fn warnings_survive_quiet() {
+    let dir = staged_pipeline("parisch", &["parisch.msh"]);
+    let msh = dir.path().join("meshes/parisch.msh");
+    let mut bytes = std::fs::read(&msh).unwrap();
+    bytes.extend_from_slice(b"$Custom\nnot for us\n$EndCustom\n");
+    std::fs::write(&msh, bytes).unwrap();
+    let yaml = dir.path().join("pipelines/parisch.yaml");
+    let text = std::fs::read_to_string(&yaml).unwrap();
+    let penalty = "{pair: contact, eps_n: 1.0e5, enforcement: penalty}";
+    assert!(text.contains(penalty), "the shipped pipeline's contact line changed");
+    let unreachable = "{pair: contact, eps_n: 1.0e5, enforcement: augmented_lagrangian, penetration_tolerance: 1.0e-14, max_augmentations: 1}";
+    std::fs::write(&yaml, text.replace(penalty, unreachable)).unwrap();
+
+    let o = run("sc-pipeline", &["-q", "pipelines/parisch.yaml"], dir.path());
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    let lines: Vec<&str> = err.lines().collect();
+    assert!(lines.iter().all(|l| l.starts_with("warning: ")), "only warnings when quiet: {err}");
+    assert!(lines.iter().any(|l| l.contains("parisch.msh") && l.contains("$Custom")), "the import warning: {err}");
+    assert!(lines.iter().any(|l| l.contains("pair 'contact' still penetrates") && l.contains("after 1 augmentations")), "the solver warning: {err}");
+
+    let o = run("sc-import", &["meshes/parisch.msh", "-o", "p.scmesh", "-q"], dir.path());
+    assert!(o.status.success() && stderr(&o).starts_with("sc-import: warning: ") && stderr(&o).contains("$Custom"), "{}", stderr(&o));
+    // without -q the summary comes first, then the same warning
+    let o = run("sc-import", &["meshes/parisch.msh", "-o", "p.scmesh"], dir.path());
+    assert!(stderr(&o).starts_with("read ") && stderr(&o).contains("sc-import: warning: "), "{}", stderr(&o));
+}

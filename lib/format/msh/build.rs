@@ -80,11 +80,11 @@ pub(super) fn build(
     nodes: Nodes,
     elements: Elements,
     names: Vec<PhysicalName>,
-    mut warnings: Vec<String>,
+    located: Vec<String>,
 ) -> Result<(Mesh, ImportReport), MshError> {
     let file = cur.file;
-    let Elements { mut hexes, hex_tags, hex_volume, flipped, groups, warnings: element_warnings, .. } = elements;
-    warnings.extend(element_warnings);
+    // `located` name their file and line already; these are of the whole file
+    let Elements { mut hexes, hex_tags, hex_volume, flipped, groups, mut warnings, .. } = elements;
     if hexes.is_empty() {
         return Err(MshError::NoHexes { file: file.to_string() });
     }
@@ -324,6 +324,7 @@ pub(super) fn build(
         node_tags,
         element_tags: hex_tags,
     };
+    let warnings = located.into_iter().chain(warnings.into_iter().map(|w| format!("{file}: {w}"))).collect();
     let report = ImportReport { version: header.describe(), dropped_nodes, flipped_elements: flipped, warnings };
     Ok((mesh, report))
 }

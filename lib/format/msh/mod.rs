@@ -79,6 +79,8 @@ pub struct ImportReport {
     pub dropped_nodes: Vec<u64>,
     /// gmsh tags of the mirrored hexahedra that were reordered.
     pub flipped_elements: Vec<u64>,
+    /// What was read but not as expected, each naming the file (and the line where
+    /// there is one): printed by every caller, even when asked to be quiet.
     pub warnings: Vec<String>,
 }
 

@@ -329,6 +329,8 @@ fn unnamed_groups_and_unnamed_volume() {
         assert_eq!(mesh.hex_body, vec![0, 1]);
         assert!(mesh.face_set("physical_2_3").is_some());
         assert!(report.warnings.iter().any(|w| w.contains("no physical volume")), "{:?}", report.warnings);
+        // every warning names the file
+        assert!(report.warnings.iter().all(|w| w.starts_with("t.msh")), "{:?}", report.warnings);
     }
 }
 
