@@ -34,6 +34,8 @@ pub struct PairSettings {
     /// Largest accepted penetration (length), augmented Lagrangian.
     pub penetration_tolerance: f64,
     pub max_augmentations: u32,
+    /// Retries of a failed solve with half the last Uzawa update (`solver::uzawa`).
+    pub update_halvings: u32,
     /// Coulomb coefficient μ and tangential penalty ε_T (μ = 0: frictionless).
     pub mu: f64,
     pub eps_t: f64,
@@ -186,6 +188,30 @@ pub struct PairSolver {
     pub t_t_vector: Vec<Vec3>,
     pub slipping: Vec<bool>,
     pub slave_force: Vec<Vec3>,
+}
+
+/// A snapshot of the multipliers an Uzawa update sets ([`PairSolver::multipliers`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Multipliers {
+    pub lambda_n: Vec<f64>,
+    pub xi_n: Vec<[f64; 2]>,
+    pub t_t_n: Vec<[f64; 2]>,
+}
+
+impl Multipliers {
+    /// A damped Uzawa update: `before + θ (after − before)`, between the iterate an
+    /// update started from and the one it set (θ = 1: the full update). A foot point
+    /// ξ̄_n without a `before` (NaN: the node first touched in this update) is taken as
+    /// `after` set it.
+    pub fn between(before: &Self, after: &Self, theta: f64) -> Self {
+        let mix = |b: f64, a: f64| if b.is_finite() { b + theta * (a - b) } else { a };
+        let mix2 = |b: &[f64; 2], a: &[f64; 2]| [mix(b[0], a[0]), mix(b[1], a[1])];
+        Self {
+            lambda_n: before.lambda_n.iter().zip(&after.lambda_n).map(|(b, a)| mix(*b, *a)).collect(),
+            xi_n: before.xi_n.iter().zip(&after.xi_n).map(|(b, a)| mix2(b, a)).collect(),
+            t_t_n: before.t_t_n.iter().zip(&after.t_t_n).map(|(b, a)| mix2(b, a)).collect(),
+        }
+    }
 }
 
 impl PairSolver {
@@ -540,6 +566,18 @@ impl PairSolver {
         self.augmentations += 1;
     }
 
+    /// The multipliers an Uzawa update sets: λ_N and, with friction, ξ̄_n and t_{Tα,n}.
+    pub fn multipliers(&self) -> Multipliers {
+        Multipliers { lambda_n: self.lambda_n.clone(), xi_n: self.xi_n.clone(), t_t_n: self.t_t_n.clone() }
+    }
+
+    /// Set the multipliers (a damped update: [`Multipliers::between`]).
+    pub fn set_multipliers(&mut self, m: &Multipliers) {
+        self.lambda_n.copy_from_slice(&m.lambda_n);
+        self.xi_n.copy_from_slice(&m.xi_n);
+        self.t_t_n.copy_from_slice(&m.t_t_n);
+    }
+
     /// Total force the master exerts on the slave body (Σ −r_s over the slaves):
     /// normal Σ −t_N A_s n̄ plus, with friction, the tangential part.
     pub fn total_force(&self) -> Vec3 {
@@ -599,5 +637,25 @@ impl PairSolver {
         self.xi_n.copy_from_slice(&self.xi_n_committed);
         self.t_t_n.copy_from_slice(&self.t_t_n_committed);
         self.augmentations = 0;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Multipliers;
+
+    #[test]
+    fn damped_update_lies_between_the_iterates() {
+        let before = Multipliers { lambda_n: vec![0.0, -2.0], xi_n: vec![[0.1, 0.2], [f64::NAN; 2]], t_t_n: vec![[1.0, 0.0], [0.0, 0.0]] };
+        let after = Multipliers { lambda_n: vec![-4.0, -1.0], xi_n: vec![[0.3, 0.2], [0.5, 0.6]], t_t_n: vec![[3.0, -2.0], [0.0, 1.0]] };
+        assert_eq!(Multipliers::between(&before, &after, 1.0), after);
+        let half = Multipliers::between(&before, &after, 0.5);
+        assert_eq!(half.lambda_n, vec![-2.0, -1.5]);
+        assert!((half.xi_n[0][0] - 0.2).abs() < 1e-15 && half.xi_n[0][1] == 0.2);
+        // a node without a foot point before the update keeps the one it was given
+        assert_eq!(half.xi_n[1], [0.5, 0.6]);
+        assert_eq!(half.t_t_n, vec![[2.0, -1.0], [0.0, 0.5]]);
+        let none = Multipliers::between(&before, &after, 0.0);
+        assert_eq!((none.lambda_n, none.t_t_n), (before.lambda_n.clone(), before.t_t_n.clone()));
     }
 }

@@ -272,6 +272,10 @@ pub struct ContactSetup {
     /// Most Uzawa updates per increment.
     #[serde(default = "default_max_augmentations")]
     pub max_augmentations: u32,
+    /// How often a Newton solve that fails after an Uzawa update is retried with half
+    /// the update before the load step is cut back (`solver::uzawa`).
+    #[serde(default = "default_update_halvings")]
+    pub update_halvings: u32,
     /// Coulomb friction coefficient μ (0: frictionless).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub mu: f64,
@@ -291,6 +295,10 @@ fn is_zero(v: &f64) -> bool {
 
 fn default_max_augmentations() -> u32 {
     20
+}
+
+fn default_update_halvings() -> u32 {
+    crate::solver::uzawa::UPDATE_HALVINGS
 }
 
 /// The whole setup.

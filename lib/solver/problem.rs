@@ -181,7 +181,7 @@ fn contact_definitions(mesh: &Mesh, pairs: &[ContactPair], setup: &SolveSetup, f
         };
         out.push(ContactDefinition {
             pair: pair.clone(),
-            settings: PairSettings { eps_n, enforcement: c.enforcement, penetration_tolerance, max_augmentations: c.max_augmentations, mu: c.mu, eps_t, stabilization: c.stabilization },
+            settings: PairSettings { eps_n, enforcement: c.enforcement, penetration_tolerance, max_augmentations: c.max_augmentations, update_halvings: c.update_halvings, mu: c.mu, eps_t, stabilization: c.stabilization },
             eps_n_default,
             areas,
             h_master: h,

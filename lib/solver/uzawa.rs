@@ -7,17 +7,45 @@
 //! and Newton solves again from the converged state, until no pair needs an update
 //! or a pair has used its `max_augmentations` (then the increment is accepted and
 //! its summary says the penetration did not converge). Penalty pairs keep λ_N = 0.
+//!
+//! When Newton fails after an update, the update was too large a step for it (an
+//! update moves every pressed node's force at once): the solve is retried from the
+//! state the update started from with half the update, λ_N = λ_N,old + ½ Δλ_N, then a
+//! quarter, an eighth (the pairs' `update_halvings`, default [`UPDATE_HALVINGS`]),
+//! before the failure goes to the load stepping as a cutback.
 
 use super::newton::{Converged, IncrementFailure, Newton};
+use crate::contact::pair::Multipliers;
 use crate::format::scres::IterationLog;
+
+/// How often a failed solve after an Uzawa update is retried with half the update,
+/// by default.
+pub const UPDATE_HALVINGS: u32 = 3;
 
 /// Newton plus Uzawa updates at load factor `lambda`; `u` is updated in place.
 /// `note` receives one line per update.
 pub fn solve_augmented(newton: &mut Newton, lambda: f64, u: &mut [f64], on_iteration: &mut dyn FnMut(&IterationLog), note: &mut dyn FnMut(&str)) -> Result<Converged, IncrementFailure> {
     let mut iterations = Vec::new();
+    // the converged state the last update started from, and per updated pair its
+    // multipliers before and after the update
+    let mut u_start = Vec::new();
+    let mut update: Vec<(usize, Multipliers, Multipliers)> = Vec::new();
+    let mut theta = 1.0;
     loop {
         let (halvings, searched) = (newton.step_halvings, newton.line_search_steps);
-        let conv = newton.solve_increment(lambda, u, on_iteration)?;
+        let conv = match newton.solve_increment(lambda, u, on_iteration) {
+            Ok(conv) => conv,
+            Err(failure) if theta > 0.5f64.powi(halvings_allowed(newton, &update)) => {
+                theta *= 0.5;
+                note(&format!("Newton failed after the Uzawa update ({failure}): solving again with {theta} of the update"));
+                u.copy_from_slice(&u_start);
+                for (k, before, after) in &update {
+                    newton.contact[*k].set_multipliers(&Multipliers::between(before, after, theta));
+                }
+                continue;
+            }
+            Err(failure) => return Err(failure),
+        };
         iterations.extend(conv.iterations);
         if let Some((iteration, why)) = newton.frozen_at {
             note(&format!("master elements held from iteration {iteration} ({why})"));
@@ -29,8 +57,10 @@ pub fn solve_augmented(newton: &mut Newton, lambda: f64, u: &mut [f64], on_itera
             note(&format!("line search: {} corrections halved", newton.line_search_steps - searched));
         }
         let mut due = false;
+        update.clear();
+        theta = 1.0;
         let node_tags = &newton.problem.node_tags;
-        for pair in &mut newton.contact {
+        for (k, pair) in newton.contact.iter_mut().enumerate() {
             pair.update_states().map_err(|(node, error)| IncrementFailure::Contact {
                 iteration: 0,
                 pair: pair.name.clone(),
@@ -48,12 +78,22 @@ pub fn solve_augmented(newton: &mut Newton, lambda: f64, u: &mut [f64], on_itera
                     pair.augmentations + 1,
                     if pair.settings.frictional() { ", t_T,n ← t_T" } else { "" }
                 ));
+                let before = pair.multipliers();
                 pair.augment();
+                update.push((k, before, pair.multipliers()));
                 due = true;
             }
         }
         if !due {
             return Ok(Converged { iterations });
         }
+        u_start.clear();
+        u_start.extend_from_slice(u);
     }
+}
+
+/// How often the last update may be halved: the fewest retries any updated pair
+/// allows (none when no pair was updated).
+fn halvings_allowed(newton: &Newton, update: &[(usize, Multipliers, Multipliers)]) -> i32 {
+    update.iter().map(|(k, _, _)| newton.contact[*k].settings.update_halvings as i32).min().unwrap_or(0)
 }
