@@ -10,7 +10,8 @@
 //! Newton corrections and cutbacks. docs/validation.md, "Shallow ironing", has the
 //! table these numbers come from. The facet master reaches the end of the sliding only with
 //! the master-surface stabilisation and a penalty (the facet chains of both
-//! pipelines, also run to t = 1.5 here): docs/validation.md says what was tried.
+//! pipelines, run here to their end, t = 2, and pinned at t = 1.5):
+//! docs/validation.md says what was tried.
 
 use serde_yaml::{Mapping, Value};
 
@@ -28,8 +29,9 @@ const ELEMENT: f64 = 0.2;
 const STEADY: (f64, f64) = (2.0, 5.0);
 
 /// The shipped pipeline `name` reduced to its `chain` ("b4": the B-spline [2, 4]
-/// master; "facet") stages (import, tag, solve), ending at t = 1.5.
-fn derived_pipeline(name: &str, chain: &str) -> String {
+/// master; "facet") stages (import, tag, solve), ending at t = 1.5 when `shortened`
+/// (else at the shipped t = 2).
+fn derived_pipeline(name: &str, chain: &str, shortened: bool) -> String {
     let path = repo().join(format!("pipelines/{name}.yaml"));
     let text = std::fs::read_to_string(&path).unwrap();
     // serde_yaml resolves the `&ironing_setup` anchor and its aliases into copies
@@ -50,12 +52,15 @@ fn derived_pipeline(name: &str, chain: &str) -> String {
             let inc = setup.get_mut("increments").and_then(Value::as_mapping_mut).unwrap();
             // the published step, 0.01 of t (200 increments over [0, 2])
             assert_eq!(inc.get("count").and_then(Value::as_u64), Some(200), "{name}: increments");
+            n_solves += 1;
+            if !shortened {
+                continue;
+            }
             let mut m = Mapping::new();
             m.insert("count".into(), 150.into());
             m.insert("end".into(), 1.5.into());
             m.insert("max_cutbacks".into(), inc.get("max_cutbacks").cloned().unwrap_or(6.into()));
             *inc = m;
-            n_solves += 1;
         }
     }
     assert_eq!(n_solves, 1, "{name}: one {chain} solve stage");
@@ -65,7 +70,7 @@ fn derived_pipeline(name: &str, chain: &str) -> String {
 /// Runs the derived pipeline of `name`: the sliding's histories (travel
 /// 10 (t − 1), V = −R_y, H = R_x on the indenter top) and the results.
 fn solve(name: &str, chain: &str) -> (History, Results) {
-    let run = solve_pipeline(name, chain, &derived_pipeline(name, chain));
+    let run = solve_pipeline(name, chain, &derived_pipeline(name, chain, true));
     assert!((run.0.s.last().unwrap() - 5.0).abs() < 1e-9, "{name}: the run ends at t = 1.5");
     run
 }
@@ -180,7 +185,7 @@ const DEFAULT_EPS_N: f64 = 13905.704099821765;
 #[test]
 fn shallow_ironing_default_penalty_does_not_matter() {
     let name = "shallow_ironing";
-    let mut doc: Value = serde_yaml::from_str(&derived_pipeline(name, "b4")).unwrap();
+    let mut doc: Value = serde_yaml::from_str(&derived_pipeline(name, "b4", true)).unwrap();
     let stages = doc.get_mut("stages").and_then(Value::as_sequence_mut).unwrap();
     let setup = stages.iter_mut().find_map(|s| s.get_mut("solve")).and_then(|s| s.get_mut("setup")).unwrap();
     let inc = setup.get_mut("increments").and_then(Value::as_mapping_mut).unwrap();
@@ -196,17 +201,26 @@ fn shallow_ironing_default_penalty_does_not_matter() {
     assert!((h / v - 0.3147).abs() < 2e-3, "H/V(1.2) = {} with 2 × the default ε_N (default: 0.3147)", h / v);
 }
 
-/// The facet chain of `name` to t = 1.5, checked against its pins; the target:
-/// the cubic B-spline master's V oscillation (`bspline`, held by the B-spline test on
-/// the same mesh and load path) at most 1/5 of the facets'; the stabilisation small.
-/// V(1.5), H(1.5) and the history.
+/// The facet chain of `name` as shipped: it must reach the end of the sliding (t = 2;
+/// a shipped pipeline runs to its end), and up to t = 1.5 it is checked against its
+/// pins (the increments up to 1.5 are those of a run ended there); the issue's
+/// target: the cubic B-spline master's V oscillation (`bspline`, held by the B-spline
+/// test on the same mesh and load path) at most 1/5 of the facets'; the stabilisation
+/// small. V(1.5), H(1.5) and the history to t = 1.5.
 fn solve_facet(name: &str, pin: &Pin, bspline: &Pin) -> (f64, f64, History) {
-    let run = solve(name, "facet");
+    let (full, mut results) = solve_pipeline(name, "facet", &derived_pipeline(name, "facet", false));
+    assert!((full.s.last().unwrap() - SLIDE).abs() < 1e-9, "{name}: the facet chain ends at t = 2");
+    check_stabilization(&results);
+    let upto = |s: &f64| *s <= 5.0 + 1e-9;
+    let keep: Vec<bool> = full.s.iter().map(upto).collect();
+    let pick = |v: &[f64]| v.iter().zip(&keep).filter(|(_, k)| **k).map(|(x, _)| *x).collect::<Vec<f64>>();
+    let r = History { s: pick(&full.s), v: pick(&full.v), h: pick(&full.h), t_over_n: pick(&full.t_over_n) };
+    results.increments.retain(|i| i.info.load_factor <= 1.5 + 1e-9);
+    let run = (r, results);
     let (v, h) = check(&format!("{name}-facet"), &run, pin);
-    let (r, results) = run;
+    let (r, _) = run;
     let osc = oscillation(&r.s, &r.v, ELEMENT, STEADY.0, STEADY.1).unwrap().rms;
     assert!(bspline.v_rms <= 0.2 * osc, "{name}: B-spline [2, 4] V oscillation {:.3e} vs facet {osc:.3e}", bspline.v_rms);
-    check_stabilization(&results);
     (v, h, r)
 }
 
@@ -221,11 +235,12 @@ fn check_stabilization(results: &Results) {
 }
 
 /// The facet chain of pipelines/shallow_ironing.yaml (μ = 0.3; penalty, master-surface
-/// stabilisation 0.15 and friction on creases; docs/validation.md), up to t = 1.5.
+/// stabilisation 0.2 and friction on creases; docs/validation.md), to t = 2, pinned at
+/// t = 1.5.
 #[test]
 fn shallow_ironing_coulomb_facet_stabilized() {
     let name = "shallow_ironing";
-    // target ratio measured 0.021 (1.08e-4 against 5.05e-3)
+    // target ratio measured 0.029 (1.08e-4 against 3.73e-3)
     let (v, h, r) = solve_facet(name, &PIN_FACET_COULOMB, &PIN_COULOMB);
     assert!((0.30..=0.53).contains(&(h / v)), "{name}: H/V(1.5) = {} outside the published 0.30–0.53", h / v);
     // Every pressed node slides in steady sliding and the facets' normals are straight
@@ -247,10 +262,11 @@ fn shallow_ironing_coulomb_facet_stabilized() {
 /// stabilisation's share of the load (docs/validation.md).
 const PIN_FACET_FRICTIONLESS: Pin = Pin { v_15: 371.50, v_rms: 3.87e-3, newton: 747, cutbacks: 0 };
 /// With μ = 0.3 (2026-11-23), tolerances as above: V(1.5) inside the published band,
-/// 7.3 % under the B-spline [2, 4] master's (399.9; the penalty and the stabilisation,
-/// as without friction). Re-pinned with the friction transfer through the tangent
-/// plane (docs/theory.md; before: 373.39, 5.37e-3, 893 corrections, 16 cutbacks).
-const PIN_FACET_COULOMB: Pin = Pin { v_15: 370.67, v_rms: 5.05e-3, newton: 818, cutbacks: 12 };
+/// 7.1 % under the B-spline [2, 4] master's (399.9; the penalty and the stabilisation,
+/// as without friction). Re-pinned with the stabilisation raised from 0.15 to 0.2: at
+/// 0.15 the chain stopped at t = 1.809 once the friction element's arithmetic changed
+/// at round-off (db9fa4e); before: 370.67, 5.05e-3, 818 corrections, 12 cutbacks.
+const PIN_FACET_COULOMB: Pin = Pin { v_15: 371.70, v_rms: 3.73e-3, newton: 759, cutbacks: 4 };
 /// ‖f_stab‖ / ‖F_contact‖ over the sliding: measured at most 0.045 (at the slide's
 /// start, where the extrapolated pressing motion turns into sliding; ~0.02 after).
 const STAB_LIMIT: f64 = 0.07;
