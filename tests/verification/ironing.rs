@@ -7,7 +7,7 @@
 //! iterations and cutbacks of every master. docs/validation.md, "3D ironing", has
 //! the table these numbers come from.
 
-use splinecontact::format::scres::{Results, RunStatus};
+use splinecontact::format::scres::{Increment, PairSummary, Results, RunStatus};
 use splinecontact::post::oscillation::oscillation;
 
 use super::sliding::{history, newton_and_cutbacks, History};
@@ -151,8 +151,10 @@ fn ironing3d_augmented_lagrangian_on_a_coarse_die() {
     std::fs::write(dir.path().join(format!("pipelines/{name}.yaml")), yaml.replace(penalty, "{pair: contact}")).unwrap();
     let masters = run_staged(&dir, name);
     check("augmented Lagrangian, 18-element die", &masters, &PINS_AUGMENTED_COARSE_DIE);
+    fn pair(i: &Increment) -> &PairSummary {
+        &i.info.contact[0]
+    }
     for (m, _, r) in &masters {
-        let pair = |i: &splinecontact::format::scres::Increment| i.info.contact[0].clone();
         // the Uzawa loop ran (the pipeline edit took: the penalty reports none; measured
         // 63 facet, 13 B4 — the multipliers carried over from the last increment leave
         // little to update) and met its tolerance, 1e-3 of the master's mean edge

@@ -211,12 +211,8 @@ fn solve_facet(name: &str, pin: &Pin, bspline: &Pin) -> (f64, f64, History) {
     let (full, mut results) = solve_pipeline(name, "facet", &derived_pipeline(name, "facet", false));
     assert!((full.s.last().unwrap() - SLIDE).abs() < 1e-9, "{name}: the facet chain ends at t = 2");
     check_stabilization(&results);
-    let upto = |s: &f64| *s <= 5.0 + 1e-9;
-    let keep: Vec<bool> = full.s.iter().map(upto).collect();
-    let pick = |v: &[f64]| v.iter().zip(&keep).filter(|(_, k)| **k).map(|(x, _)| *x).collect::<Vec<f64>>();
-    let r = History { s: pick(&full.s), v: pick(&full.v), h: pick(&full.h), t_over_n: pick(&full.t_over_n) };
     results.increments.retain(|i| i.info.load_factor <= 1.5 + 1e-9);
-    let run = (r, results);
+    let run = (full.until(5.0), results);
     let (v, h) = check(&format!("{name}-facet"), &run, pin);
     let (r, _) = run;
     let osc = oscillation(&r.s, &r.v, ELEMENT, STEADY.0, STEADY.1).unwrap().rms;

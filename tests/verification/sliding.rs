@@ -17,6 +17,17 @@ pub struct History {
     pub t_over_n: Vec<f64>,
 }
 
+impl History {
+    /// The history up to the travel `s_max` (the travel grows along the rows).
+    pub fn until(mut self, s_max: f64) -> Self {
+        let n = self.s.iter().take_while(|s| **s <= s_max + 1e-9).count();
+        for column in [&mut self.s, &mut self.v, &mut self.h, &mut self.t_over_n] {
+            column.truncate(n);
+        }
+        self
+    }
+}
+
 /// Reads the rows with t ≥ `start` (the sliding) of the forces CSV at `path`:
 /// reactions on `set` (`vertical` is its axis pressed into the other body, "y" or
 /// "z"), contact forces of the pair `contact`.
