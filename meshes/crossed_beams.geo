@@ -21,14 +21,17 @@
 // x = 150, z = 20.2: 3 nodes), upper_tip (x = 150 face), upper_bottom (slave),
 // lower_top (master, 3 x 16 node net), lower_ends (y = +-75 faces, clamped).
 // Regenerate: gmsh meshes/crossed_beams.geo -3 -format msh41 -o meshes/crossed_beams.msh
-//             (parameters: -setnumber gap|xc|lu|ll value)
+//             (parameters: -setnumber gap|xc|lu|ll|nc|nl value; the refinement levels of
+//             docs/performance.md use nc = n, nl = 15 n)
 Mesh.MshFileVersion = 4.1;
 
 DefineConstant[
   gap = {0.2, Name "Parameters/gap"},     // initial gap between the beams
   lu = {150, Name "Parameters/lu"},       // upper beam length (along x)
   ll = {150, Name "Parameters/ll"},       // lower beam length (along y)
-  xc = {110, Name "Parameters/xc"}        // x of the lower beam's axis
+  xc = {110, Name "Parameters/xc"},       // x of the lower beam's axis
+  nc = {2, Name "Parameters/nc"},         // elements across each section (y/x and z)
+  nl = {15, Name "Parameters/nl"}         // elements along each beam
 ];
 bu = 10; hu = 10;                         // upper section: width (y), height (z)
 bl = 20; hl = 10;                         // lower section: width (x), height (z)
@@ -40,10 +43,10 @@ Point(3) = {xc + bl/2, -ll/2, hl}; Point(4) = {xc - bl/2, -ll/2, hl};
 Line(1) = {1, 2}; Line(2) = {2, 3}; Line(3) = {3, 4}; Line(4) = {4, 1};
 Curve Loop(1) = {1, 2, 3, 4};
 Plane Surface(1) = {1};
-Transfinite Curve {1, 2, 3, 4} = 3;       // 2 elements across the section
+Transfinite Curve {1, 2, 3, 4} = nc + 1;  // nc elements across the section
 Transfinite Surface {1};
 Recombine Surface {1};
-low[] = Extrude {0, ll, 0} { Surface{1}; Layers{15}; Recombine; };
+low[] = Extrude {0, ll, 0} { Surface{1}; Layers{nl}; Recombine; };
 // low[0] = end face y = +ll/2, low[1] = volume
 
 // ---- upper beam: section in the plane x = 0, extruded along x (tags from 1000 up) ----
@@ -54,10 +57,10 @@ Line(1001) = {1001, 1002}; Line(1002) = {1002, 1003};
 Line(1003) = {1003, 1004}; Line(1004) = {1004, 1001};
 Curve Loop(1001) = {1001, 1002, 1003, 1004};
 Plane Surface(1001) = {1001};
-Transfinite Curve {1001:1004} = 3;
+Transfinite Curve {1001:1004} = nc + 1;
 Transfinite Surface {1001};
 Recombine Surface {1001};
-up[] = Extrude {lu, 0, 0} { Surface{1001}; Layers{15}; Recombine; };
+up[] = Extrude {lu, 0, 0} { Surface{1001}; Layers{nl}; Recombine; };
 // up[0] = free-end face x = lu, up[1] = volume
 
 upper_bottom[] = Surface In BoundingBox {-e, -bu/2 - e, zu - e, lu + e, bu/2 + e, zu + e};

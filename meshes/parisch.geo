@@ -6,17 +6,20 @@
 //   upper block  x,y in [-10, 10], z in [10, 22]   (rests on the lower block, gap 0)
 // The load node is the centre of the upper block's top face, (0, 0, 22).
 // Regenerate: gmsh meshes/parisch.geo -3 -format msh41 -o meshes/parisch.msh
+// (-setnumber r R splits every element R times per direction: the refinement levels
+// of docs/performance.md; r = 1 is the paper's mesh)
 Mesh.MshFileVersion = 4.1;
+DefineConstant[ r = {1, Name "Parameters/r"} ];
 
 // ---- lower block: one transfinite quad surface extruded one layer ----
 Point(1) = {-15, -15, 0}; Point(2) = {15, -15, 0}; Point(3) = {15, 15, 0}; Point(4) = {-15, 15, 0};
 Line(1) = {1, 2}; Line(2) = {2, 3}; Line(3) = {3, 4}; Line(4) = {4, 1};
 Curve Loop(1) = {1, 2, 3, 4};
 Plane Surface(1) = {1};
-Transfinite Curve {1, 2, 3, 4} = 4;          // 3 elements per side
+Transfinite Curve {1, 2, 3, 4} = 3 * r + 1;  // 3 r elements per side
 Transfinite Surface {1};
 Recombine Surface {1};
-lower[] = Extrude {0, 0, 10} { Surface{1}; Layers{1}; Recombine; };
+lower[] = Extrude {0, 0, 10} { Surface{1}; Layers{r}; Recombine; };
 // lower[0] = top surface, lower[1] = volume
 
 // ---- upper block: four quadrants around a centre point, so the load node is a geometric point ----
@@ -35,12 +38,12 @@ Curve Loop(1011) = {1011, 1019, -1013, -1017}; Plane Surface(1011) = {1011};
 Curve Loop(1012) = {1012, 1021, -1014, -1019}; Plane Surface(1012) = {1012};
 Curve Loop(1013) = {1013, 1020, -1015, -1018}; Plane Surface(1013) = {1013};
 Curve Loop(1014) = {1014, 1022, -1016, -1020}; Plane Surface(1014) = {1014};
-Transfinite Curve {1011:1022} = 2;           // one element per quadrant
+Transfinite Curve {1011:1022} = r + 1;       // r elements per quadrant side
 Transfinite Surface {1011:1014};
 Recombine Surface {1011:1014};
 // One extrusion of all four quadrants, so shared edges stay shared (a conforming block).
 // For each surface gmsh returns: top, volume, then its 4 lateral surfaces.
-up[] = Extrude {0, 0, h} { Surface{1011:1014}; Layers{1}; Recombine; };
+up[] = Extrude {0, 0, h} { Surface{1011:1014}; Layers{r}; Recombine; };
 load_pt[] = Point In BoundingBox {-0.1, -0.1, zb + h - 0.1, 0.1, 0.1, zb + h + 0.1};
 
 Physical Volume("lower") = {lower[1]};

@@ -226,15 +226,97 @@ impl Default for NewtonSetup {
     }
 }
 
+/// Which linear solver a Newton iteration uses (`linear_solver:`, or its `method:`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, Default)]
 #[serde(rename_all = "lowercase")]
 pub enum LinearSolverChoice {
-    /// Cholesky while the tangent is symmetric (LDLᵀ if it is indefinite), LU otherwise.
+    /// Cholesky while the tangent is symmetric (LDLᵀ if it is indefinite); GMRES
+    /// preconditioned by the symmetric part's factorization when it is not.
     #[default]
     Auto,
     Cholesky,
     Ldlt,
+    /// faer's sparse LU (COLAMD ordering, partial pivoting).
     Lu,
+    /// GMRES preconditioned by the factorization of the symmetric part (LU fallback).
+    Gmres,
+}
+
+/// Fill-reducing ordering of the Cholesky-type factorizations.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum OrderingChoice {
+    /// METIS nested dissection on the node graph.
+    #[default]
+    NestedDissection,
+    /// faer's approximate minimum degree.
+    Amd,
+}
+
+/// The linear solver: `linear_solver: auto` (a method alone) or a map with these keys.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct LinearSolverSetup {
+    pub method: LinearSolverChoice,
+    pub ordering: OrderingChoice,
+    /// GMRES: relative residual ‖b − K x‖/‖b‖ to reach.
+    pub gmres_tolerance: f64,
+    /// GMRES: most iterations per solve before the LU fallback.
+    pub gmres_max_iterations: u32,
+}
+
+impl Default for LinearSolverSetup {
+    fn default() -> Self {
+        Self { method: LinearSolverChoice::Auto, ordering: OrderingChoice::NestedDissection, gmres_tolerance: 1e-12, gmres_max_iterations: 100 }
+    }
+}
+
+impl From<LinearSolverChoice> for LinearSolverSetup {
+    fn from(method: LinearSolverChoice) -> Self {
+        Self { method, ..Default::default() }
+    }
+}
+
+/// The map form of [`LinearSolverSetup`], every key optional.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct LinearSolverMap {
+    #[serde(default)]
+    method: LinearSolverChoice,
+    #[serde(default)]
+    ordering: OrderingChoice,
+    gmres_tolerance: Option<f64>,
+    gmres_max_iterations: Option<u32>,
+}
+
+impl<'de> Deserialize<'de> for LinearSolverSetup {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct Visitor;
+        impl<'de> serde::de::Visitor<'de> for Visitor {
+            type Value = LinearSolverSetup;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a method (auto, cholesky, ldlt, lu, gmres) or a map with keys method, ordering, gmres_tolerance, gmres_max_iterations")
+            }
+            fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<Self::Value, E> {
+                let method = LinearSolverChoice::deserialize(serde::de::value::StrDeserializer::<E>::new(v))?;
+                Ok(method.into())
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(self, map: A) -> Result<Self::Value, A::Error> {
+                let m = LinearSolverMap::deserialize(serde::de::value::MapAccessDeserializer::new(map))?;
+                let d = LinearSolverSetup::default();
+                let tolerance = m.gmres_tolerance.unwrap_or(d.gmres_tolerance);
+                if !(tolerance > 0.0 && tolerance < 1.0) {
+                    return Err(serde::de::Error::custom(format!("gmres_tolerance must lie in (0, 1), got {tolerance}")));
+                }
+                Ok(LinearSolverSetup {
+                    method: m.method,
+                    ordering: m.ordering,
+                    gmres_tolerance: tolerance,
+                    gmres_max_iterations: m.gmres_max_iterations.unwrap_or(d.gmres_max_iterations),
+                })
+            }
+        }
+        deserializer.deserialize_any(Visitor)
+    }
 }
 
 /// How a pair's normal constraint is enforced (paper sec. 4).
@@ -317,7 +399,7 @@ pub struct SolveSetup {
     #[serde(default)]
     pub newton: NewtonSetup,
     #[serde(default)]
-    pub linear_solver: LinearSolverChoice,
+    pub linear_solver: LinearSolverSetup,
     /// Named amplitudes for constraints and loads.
     #[serde(default)]
     #[serde(skip_serializing_if = "Vec::is_empty")]
@@ -387,7 +469,7 @@ mod tests {
         let y = "materials:\n  - {body: b, model: neo_hookean, E: 1.0e4, nu: 0.3}\nconstraints:\n  - {set: base, fix: [x, y, z]}\n  - {set: top, displacement: {z: -1.0}}\nloads:\n  - {set: p, force: [0, 0, -1]}\n  - {face_set: f, pressure: 2}\nincrements: {factors: [0.5, 1.0]}\nnewton: {max_iterations: 10}\nlinear_solver: lu\n";
         let s = SolveSetup::parse("s.yaml", y).unwrap();
         assert_eq!(s.load_factors("s").unwrap(), vec![0.5, 1.0]);
-        assert_eq!(s.linear_solver, LinearSolverChoice::Lu);
+        assert_eq!(s.linear_solver, LinearSolverChoice::Lu.into());
         assert_eq!(s.constraints[1].displacement.as_ref().unwrap().z, Some(-1.0));
     }
 
@@ -397,6 +479,29 @@ mod tests {
         assert!(e.contains("rho") && e.contains("line 2"), "{e}");
         let e = SolveSetup::parse("s.yaml", "materials:\n  - {body: b, model: mooney, E: 1, nu: 0.3}\n").unwrap_err().to_string();
         assert!(e.contains("mooney") && e.contains("neo_hookean"), "{e}");
+    }
+
+    #[test]
+    fn linear_solver_as_a_word_or_a_map() {
+        let s = SolveSetup::parse("s", "materials: []\nlinear_solver: gmres\n").unwrap();
+        assert_eq!(s.linear_solver, LinearSolverChoice::Gmres.into());
+        let s = SolveSetup::parse("s", "materials: []\nlinear_solver: {ordering: amd, gmres_tolerance: 1.0e-10}\n").unwrap();
+        let d = LinearSolverSetup::default();
+        assert_eq!(s.linear_solver, LinearSolverSetup { ordering: OrderingChoice::Amd, gmres_tolerance: 1e-10, ..d });
+        // the default, and what a results file's setup echo reads back
+        let s = SolveSetup::parse("s", "materials: []\n").unwrap();
+        assert_eq!(s.linear_solver, d);
+        let echo = serde_yaml::to_string(&s).unwrap();
+        assert_eq!(SolveSetup::parse("echo", &echo).unwrap().linear_solver, d);
+        for (text, expect) in [
+            ("linear_solver: superlu\n", "unknown variant `superlu`"),
+            ("linear_solver: {method: lu, orderng: amd}\n", "unknown field `orderng`"),
+            ("linear_solver: {gmres_tolerance: 2}\n", "gmres_tolerance must lie in (0, 1)"),
+            ("linear_solver: [lu]\n", "a method (auto, cholesky, ldlt, lu, gmres) or a map"),
+        ] {
+            let e = SolveSetup::parse("s.yaml", &format!("materials: []\n{text}")).unwrap_err().to_string();
+            assert!(e.contains(expect) && e.contains("line 2"), "{text}: {e}");
+        }
     }
 
     #[test]

@@ -14,8 +14,8 @@
 //! numeric refactorization; only a new pattern (contact groups changed) or a change
 //! of [`Symmetry`] needs a new `analyse`.
 //!
-//! **Which factorization.** [`Symmetry::Symmetric`]: `LLᵀ` (Cholesky, AMD
-//! ordering, supernodal) for the symmetric positive definite tangent; when it
+//! **Which factorization.** [`Symmetry::Symmetric`]: `LLᵀ` (Cholesky, nested
+//! dissection or AMD ordering ([`super::ordering`]), supernodal) for the symmetric positive definite tangent; when it
 //! meets a non-positive pivot, `LDLᵀ` on the same symbolic factorization
 //! (symmetric indefinite, no pivoting: fails only on a zero pivot).
 //! [`Symmetry::General`]: `LU` with partial pivoting (COLAMD ordering), for the
@@ -51,7 +51,10 @@ use faer::sparse::linalg::lu::{factorize_symbolic_lu, LuRef, NumericLu, Symbolic
 use faer::linalg::cholesky::llt::factor::LltError;
 use faer::sparse::linalg::LuError;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
+use faer::perm::PermRef;
 use faer::{Conj, MatMut, Par, Side};
+
+use super::ordering::{nested_dissection, FillOrdering};
 
 /// Structure of the matrix, chosen by the caller (the tangent is symmetric
 /// without friction, non-symmetric with it).
@@ -92,6 +95,19 @@ pub struct SolverTimings {
     pub n_symbolic: usize,
     pub n_numeric: usize,
     pub n_solve: usize,
+    /// Krylov iterations over all solves (iterative backends).
+    pub n_krylov: usize,
+    /// Solves an iterative backend handed to its direct fallback.
+    pub n_fallback: usize,
+}
+
+/// What the last `solve_in_place` did, for the log.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SolveReport {
+    /// Krylov iterations (0 for a direct solve).
+    pub krylov_iterations: usize,
+    /// Why an iterative backend solved this system by its direct fallback.
+    pub fallback: Option<String>,
 }
 
 /// Linear-solver failures.
@@ -137,9 +153,13 @@ pub trait LinearSolver: Send {
     /// Numeric factorization of the matrix with these values (pattern order).
     fn factor(&mut self, values: &[f64]) -> Result<FactorInfo, LinearSolverError>;
     /// Overwrites `rhs` with the solution of `A x = rhs`.
-    fn solve_in_place(&self, rhs: &mut [f64]) -> Result<(), LinearSolverError>;
+    fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolverError>;
     /// Accumulated timings since construction.
     fn timings(&self) -> SolverTimings;
+    /// What the last `solve_in_place` did (a direct backend: nothing to say).
+    fn last_solve(&self) -> SolveReport {
+        SolveReport::default()
+    }
 }
 
 /// Options of [`FaerDirect`].
@@ -152,11 +172,14 @@ pub struct FaerDirectOptions {
     /// Relative pivot size below which a Cholesky-type factorization is reported
     /// singular (default `1e-13`; `0` disables the check).
     pub singular_pivot_tolerance: f64,
+    /// Fill-reducing ordering of the Cholesky-type factorizations (LU always uses
+    /// faer's COLAMD).
+    pub ordering: FillOrdering,
 }
 
 impl Default for FaerDirectOptions {
     fn default() -> Self {
-        Self { par: None, symmetric: SymmetricStrategy::LltThenLdlt, singular_pivot_tolerance: 1e-13 }
+        Self { par: None, symmetric: SymmetricStrategy::LltThenLdlt, singular_pivot_tolerance: 1e-13, ordering: FillOrdering::default() }
     }
 }
 
@@ -380,10 +403,20 @@ impl LinearSolver for FaerDirect {
             })
             .collect();
         let symbolic = match symmetry {
-            Symmetry::Symmetric => Symbolic::Cholesky(
-                factorize_symbolic_cholesky(owned.as_ref(), Side::Lower, SymmetricOrdering::Amd, Default::default())
-                    .map_err(|e| LinearSolverError::Faer(format!("{e:?}")))?,
-            ),
+            Symmetry::Symmetric => {
+                let perm = match self.options.ordering {
+                    FillOrdering::Amd => None,
+                    FillOrdering::NestedDissection => Some(nested_dissection(owned.as_ref())?),
+                };
+                let ordering = match &perm {
+                    None => SymmetricOrdering::Amd,
+                    Some(p) => SymmetricOrdering::Custom(PermRef::new_checked(&p.forward, &p.inverse, n)),
+                };
+                Symbolic::Cholesky(
+                    factorize_symbolic_cholesky(owned.as_ref(), Side::Lower, ordering, Default::default())
+                        .map_err(|e| LinearSolverError::Faer(format!("{e:?}")))?,
+                )
+            }
             Symmetry::General => Symbolic::Lu(
                 factorize_symbolic_lu(owned.as_ref(), Default::default())
                     .map_err(|e| LinearSolverError::Faer(format!("{e:?}")))?,
@@ -439,7 +472,7 @@ impl LinearSolver for FaerDirect {
         result.map(|method| FactorInfo { method, time })
     }
 
-    fn solve_in_place(&self, rhs: &mut [f64]) -> Result<(), LinearSolverError> {
+    fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolverError> {
         let start = Instant::now();
         let par = self.par();
         let n = match &self.pattern {
@@ -482,6 +515,8 @@ impl LinearSolver for FaerDirect {
             n_symbolic: self.n_symbolic,
             n_numeric: self.n_numeric,
             n_solve: self.n_solve.load(Ordering::Relaxed) as usize,
+            n_krylov: 0,
+            n_fallback: 0,
         }
     }
 }

@@ -1,4 +1,6 @@
 //! Solvers: the linear-solver interface and its faer direct backend ([`linear`]),
+//! fill-reducing orderings ([`ordering`]), GMRES ([`gmres`]) and the frictional
+//! tangent's symmetric-part-preconditioned solver ([`symmetric_part`]),
 //! the static problem ([`problem`]) and its load curves ([`amplitude`]), Newton–Raphson for one increment ([`newton`]),
 //! the augmented Lagrangian's Uzawa loop ([`uzawa`]), the master-surface
 //! stabilisation ([`stabilization`]), load
@@ -7,15 +9,18 @@
 
 pub mod amplitude;
 pub mod bench;
+pub mod gmres;
 pub mod increments;
 pub mod linear;
 pub mod log;
 pub mod newton;
+pub mod ordering;
 pub mod problem;
 pub mod restart;
 pub mod stabilization;
+pub mod symmetric_part;
 pub mod uzawa;
 
 pub use linear::{
-    FactorInfo, FaerDirect, FaerDirectOptions, Factorization, LinearSolver, LinearSolverError, SolverTimings, SymmetricStrategy, Symmetry,
+    FactorInfo, FaerDirect, FaerDirectOptions, Factorization, LinearSolver, LinearSolverError, SolveReport, SolverTimings, SymmetricStrategy, Symmetry,
 };

@@ -23,8 +23,11 @@ use crate::contact::pair::{PairError, PairSolver};
 use crate::fem::element::{hex8_gauss_stresses, hex8_residual_tangent, ElementError};
 use crate::fem::pressure::{follower_pressure_force_stiffness, FaceMatrix, FaceVector};
 use crate::format::scres::{Increment, IterationLog};
-use crate::format::setup::{LinearSolverChoice, NewtonSetup};
-use crate::solver::linear::{FaerDirect, FaerDirectOptions, LinearSolver, LinearSolverError, SymmetricStrategy, Symmetry};
+use crate::format::setup::{LinearSolverChoice, LinearSolverSetup, NewtonSetup, OrderingChoice};
+use crate::solver::gmres::GmresSettings;
+use crate::solver::linear::{FaerDirect, FaerDirectOptions, LinearSolver, LinearSolverError, SolverTimings, SymmetricStrategy, Symmetry};
+use crate::solver::ordering::FillOrdering;
+use crate::solver::symmetric_part::SymmetricPartGmres;
 
 /// Why an increment did not converge.
 #[derive(Debug, Clone, thiserror::Error)]
@@ -118,6 +121,9 @@ pub struct Newton<'p> {
     /// The iteration at which the current solve held the contact search's master
     /// elements, and why ([`PairSolver::freeze`]); `None` while they may change.
     pub frozen_at: Option<(u32, &'static str)>,
+    /// What the linear solver had to say since the log last took these (an
+    /// iterative solve handed to its direct fallback).
+    pub linear_notes: Vec<String>,
 }
 
 /// A converged increment's iteration history.
@@ -126,7 +132,8 @@ pub struct Converged {
 }
 
 impl<'p> Newton<'p> {
-    pub fn new(problem: &'p Problem, settings: NewtonSetup, choice: LinearSolverChoice) -> Result<Self, SetupFailure> {
+    pub fn new(problem: &'p Problem, settings: NewtonSetup, linear_setup: LinearSolverSetup) -> Result<Self, SetupFailure> {
+        let choice = linear_setup.method;
         let mut contact = Vec::with_capacity(problem.contact.len());
         for def in &problem.contact {
             contact.push(PairSolver::new(def, &problem.X)?);
@@ -144,11 +151,23 @@ impl<'p> Newton<'p> {
         }
         let (symmetry, strategy) = match choice {
             LinearSolverChoice::Auto if problem.symmetric() => (Symmetry::Symmetric, SymmetricStrategy::LltThenLdlt),
-            LinearSolverChoice::Auto | LinearSolverChoice::Lu => (Symmetry::General, SymmetricStrategy::LltThenLdlt),
+            LinearSolverChoice::Auto | LinearSolverChoice::Lu | LinearSolverChoice::Gmres => (Symmetry::General, SymmetricStrategy::LltThenLdlt),
             LinearSolverChoice::Cholesky => (Symmetry::Symmetric, SymmetricStrategy::Llt),
             LinearSolverChoice::Ldlt => (Symmetry::Symmetric, SymmetricStrategy::Ldlt),
         };
-        let mut linear: Box<dyn LinearSolver> = Box::new(FaerDirect::new(FaerDirectOptions { symmetric: strategy, ..Default::default() }));
+        let direct = FaerDirectOptions {
+            symmetric: strategy,
+            ordering: match linear_setup.ordering {
+                OrderingChoice::NestedDissection => FillOrdering::NestedDissection,
+                OrderingChoice::Amd => FillOrdering::Amd,
+            },
+            ..Default::default()
+        };
+        let gmres = GmresSettings { tolerance: linear_setup.gmres_tolerance, max_iterations: linear_setup.gmres_max_iterations as usize, ..Default::default() };
+        let mut linear: Box<dyn LinearSolver> = match (symmetry, choice) {
+            (Symmetry::General, LinearSolverChoice::Auto | LinearSolverChoice::Gmres) => Box::new(SymmetricPartGmres::new(gmres, direct)),
+            _ => Box::new(FaerDirect::new(direct)),
+        };
         linear.analyse(pattern.symbolic(), symmetry)?;
         let n = DOFS_PER_NODE * problem.n_nodes();
         let n_free = pattern.n_free();
@@ -172,6 +191,7 @@ impl<'p> Newton<'p> {
             line_search_steps: 0,
             stabilization,
             frozen_at: None,
+            linear_notes: Vec::new(),
         })
     }
 
@@ -278,6 +298,11 @@ impl<'p> Newton<'p> {
 
     pub fn linear_solver_name(&self) -> &str {
         self.linear.name()
+    }
+
+    /// The linear solver's accumulated timings and counts.
+    pub fn linear_timings(&self) -> SolverTimings {
+        self.linear.timings()
     }
 
     /// Assemble K_ff and the full residual R = f_int − f_ext(λ) at `u` (after
@@ -504,6 +529,9 @@ impl<'p> Newton<'p> {
             self.r_free.iter_mut().zip(&self.rhs).for_each(|(du, r)| *du = -r);
             self.linear.solve_in_place(&mut self.r_free).map_err(|error| IncrementFailure::Linear { iteration, error })?;
             row.seconds_solve = t.elapsed().as_secs_f64();
+            if let Some(why) = self.linear.last_solve().fallback {
+                self.linear_notes.push(format!("iteration {iteration}: {why}: solved by LU instead"));
+            }
             if iteration == 0 {
                 energy0 = self.r_free.iter().zip(&self.rhs).map(|(du, r)| du * r).sum::<f64>().abs();
             }

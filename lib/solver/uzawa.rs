@@ -33,7 +33,11 @@ pub fn solve_augmented(newton: &mut Newton, lambda: f64, u: &mut [f64], on_itera
     let mut theta = 1.0;
     loop {
         let (halvings, searched) = (newton.step_halvings, newton.line_search_steps);
-        let conv = match newton.solve_increment(lambda, u, on_iteration) {
+        let solved = newton.solve_increment(lambda, u, on_iteration);
+        for text in std::mem::take(&mut newton.linear_notes) {
+            note(&format!("linear solver: {text}"));
+        }
+        let conv = match solved {
             Ok(conv) => conv,
             Err(failure) if theta > 0.5f64.powi(halvings_allowed(newton, &update)) => {
                 theta *= 0.5;

@@ -144,6 +144,22 @@ pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, 
     if !newton.contact.is_empty() {
         log.line(&format!("contact: the sparsity pattern was rebuilt {} times as contact elements changed", newton.pattern_rebuilds));
     }
+    let t = newton.linear_timings();
+    log.line(&format!(
+        "linear solver {}: {} analyses {:.2} s, {} factorizations {:.2} s, {} solves {:.2} s{}",
+        newton.linear_solver_name(),
+        t.n_symbolic,
+        t.symbolic.as_secs_f64(),
+        t.n_numeric,
+        t.numeric.as_secs_f64(),
+        t.n_solve,
+        t.solve.as_secs_f64(),
+        if t.n_krylov > 0 || t.n_fallback > 0 {
+            format!(", {} GMRES iterations ({:.1} per solve), {} solved by the LU fallback", t.n_krylov, t.n_krylov as f64 / t.n_solve.max(1) as f64, t.n_fallback)
+        } else {
+            String::new()
+        }
+    ));
     log.finish();
     let summary = summary?;
     Ok(SolveReport { increments: summary.increments, iterations: summary.iterations, cutbacks: summary.cutbacks, seconds: start.elapsed().as_secs_f64(), write_seconds: summary.write_seconds })
