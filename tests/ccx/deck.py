@@ -776,16 +776,20 @@ def applied(model, set_name, t, U):
 
 def ccx_job(ccx, cwd, name):
     """Run ccx on cwd/<name>.inp (OMP_NUM_THREADS=1 unless set).  Returns ok, rc, log,
-    wall (seconds), version and the .dat, .sta, .cvg texts ('' if absent)."""
+    wall (seconds), peak RSS (MB), version and the .dat, .sta, .cvg texts ('' if absent)."""
     env = dict(os.environ, OMP_NUM_THREADS=os.environ.get("OMP_NUM_THREADS", "1"))
     t0 = time.perf_counter()
-    p = subprocess.run([ccx, "-i", name], cwd=cwd, env=env, capture_output=True, text=True)
-    wall = time.perf_counter() - t0
-    log = p.stdout + p.stderr
+    with open(cwd / (name + ".stdout"), "w+") as out:
+        p = subprocess.Popen([ccx, "-i", name], cwd=cwd, env=env, stdout=out, stderr=subprocess.STDOUT)
+        _, status, usage = os.wait4(p.pid, 0)   # this process's own peak RSS
+        wall = time.perf_counter() - t0
+        out.seek(0)
+        log = out.read()
+    p.returncode = os.waitstatus_to_exitcode(status)
     m = re.search(r"Version\s+([0-9][0-9.]*[0-9])", log)
     rd = lambda ext: (cwd / (name + ext)).read_text() if (cwd / (name + ext)).exists() else ""
     return dict(ok=p.returncode == 0 and "*ERROR" not in log and "Job finished" in log, rc=p.returncode,
-                log=log, wall=wall, version=m.group(1) if m else "?", dat=rd(".dat"), sta=rd(".sta"), cvg=rd(".cvg"))
+                log=log, wall=wall, peak_rss_mb=usage.ru_maxrss / 1024.0, version=m.group(1) if m else "?", dat=rd(".dat"), sta=rd(".sta"), cvg=rd(".cvg"))
 
 
 def run_ccx(deck, model, out, ccx):
@@ -798,7 +802,7 @@ def run_ccx(deck, model, out, ccx):
     (out / (name + ".log")).write_text(log)
     blocks = parse_dat(job["dat"])
     res = dict(pipeline=None, deck=shown(out / (name + ".inp")), ccx_version=job["version"],
-               ok=ok, wall_seconds=round(job["wall"], 3), notes=model["notes"])
+               ok=ok, wall_seconds=round(job["wall"], 3), peak_rss_mb=round(job["peak_rss_mb"], 1), notes=model["notes"])
     if not ok:
         err = [l for l in log.splitlines() if "ERROR" in l or "error" in l]
         res["error"] = err[-5:] or log.splitlines()[-5:]
