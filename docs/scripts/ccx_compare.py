@@ -21,6 +21,7 @@ times per direction).
 Usage (from the repository root, after `cargo build --release`):
     .venv/bin/python docs/scripts/ccx_compare.py crossed_beams --levels 2 4 6 8 10
     .venv/bin/python docs/scripts/ccx_compare.py parisch --levels 1 2 3 --json
+Our programs come from target/release (or $SC_BIN_DIR).
 Options: --threads T (2), --out DIR (pipelines/out/compare/<model>), --contact
 node|surface (ccx contact type, node by default), --no-ccx (ours only, e.g. past
 ccx's memory), --linear-solver M (ours: auto, lu, gmres, cholesky...), --ordering O
@@ -47,15 +48,19 @@ sys.path.insert(0, str(ROOT / "tests" / "py"))
 import deck  # noqa: E402  (tests/ccx/deck.py)
 import scresults  # noqa: E402  (tests/py/scresults.py)
 
-# Agreement between the two programs, relative to our value (ccx's penalty slope is
-# 100 eps_N where we use the augmented Lagrangian, its NEO HOOKE is the
-# deviatoric/volumetric form where the crossed beams use Ciarlet-Simo, and its
-# master is the bilinear facet where ours is the B-spline: on the paper's mesh the
-# three together move max |u| by 0.06 % and the reactions by less; 1 % leaves room
-# for the coarsest and finest levels without hiding a real difference, which shows
-# as several %).
-TOL_MAX_U = 1e-2
-TOL_REACTION = 1e-2
+# Agreement between the two programs, relative to our value. What differs: ccx's
+# penalty slope is 100 eps_N where we use the augmented Lagrangian, its NEO HOOKE is
+# the deviatoric/volumetric form where the crossed beams use Ciarlet-Simo, its
+# master is the bilinear facet where ours is the B-spline, and it chooses its own
+# increments (8-19 on the crossed beams; with our 3 fixed ones it diverges) where we
+# take 3. Measured on the frictional crossed beams (docs/performance.md), max |u|
+# differs by 0.03 % on the coarsest level and the gap grows with refinement to 1.1 %
+# at 110k dofs, while ours moves by 1e-5 with 12 increments instead of 3, with the
+# facet master and with the dev/vol material (so none of those three is the cause);
+# the support reaction differs by at most 0.5 %. 2 % passes that and fails on a
+# wrong load, support or contact transfer, each off by several %.
+TOL_MAX_U = 2e-2
+TOL_REACTION = 2e-2
 
 MODELS = {
     # level n -> gmsh -setnumber parameters
@@ -85,7 +90,7 @@ def gmsh_exe():
 
 
 def our_exe(name):
-    exe = ROOT / "target" / "release" / name
+    exe = Path(os.environ.get("SC_BIN_DIR") or ROOT / "target" / "release") / name
     if not exe.exists():
         sys.exit("ccx_compare.py: %s not found: run `cargo build --release` first" % exe)
     return str(exe)

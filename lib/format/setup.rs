@@ -262,11 +262,21 @@ pub struct LinearSolverSetup {
     pub gmres_tolerance: f64,
     /// GMRES: most iterations per solve before the LU fallback.
     pub gmres_max_iterations: u32,
+    /// GMRES: keep the factorization of the symmetric part for the next Newton
+    /// iteration while a solve needs at most this many iterations (0: factor every
+    /// iteration).
+    pub preconditioner_reuse: u32,
 }
 
 impl Default for LinearSolverSetup {
     fn default() -> Self {
-        Self { method: LinearSolverChoice::Auto, ordering: OrderingChoice::NestedDissection, gmres_tolerance: 1e-12, gmres_max_iterations: 100 }
+        Self {
+            method: LinearSolverChoice::Auto,
+            ordering: OrderingChoice::NestedDissection,
+            gmres_tolerance: 1e-12,
+            gmres_max_iterations: 100,
+            preconditioner_reuse: 8,
+        }
     }
 }
 
@@ -286,6 +296,7 @@ struct LinearSolverMap {
     ordering: OrderingChoice,
     gmres_tolerance: Option<f64>,
     gmres_max_iterations: Option<u32>,
+    preconditioner_reuse: Option<u32>,
 }
 
 impl<'de> Deserialize<'de> for LinearSolverSetup {
@@ -294,7 +305,7 @@ impl<'de> Deserialize<'de> for LinearSolverSetup {
         impl<'de> serde::de::Visitor<'de> for Visitor {
             type Value = LinearSolverSetup;
             fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-                f.write_str("a method (auto, cholesky, ldlt, lu, gmres) or a map with keys method, ordering, gmres_tolerance, gmres_max_iterations")
+                f.write_str("a method (auto, cholesky, ldlt, lu, gmres) or a map with keys method, ordering, gmres_tolerance, gmres_max_iterations, preconditioner_reuse")
             }
             fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<Self::Value, E> {
                 let method = LinearSolverChoice::deserialize(serde::de::value::StrDeserializer::<E>::new(v))?;
@@ -312,6 +323,7 @@ impl<'de> Deserialize<'de> for LinearSolverSetup {
                     ordering: m.ordering,
                     gmres_tolerance: tolerance,
                     gmres_max_iterations: m.gmres_max_iterations.unwrap_or(d.gmres_max_iterations),
+                    preconditioner_reuse: m.preconditioner_reuse.unwrap_or(d.preconditioner_reuse),
                 })
             }
         }

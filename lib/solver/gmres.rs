@@ -8,9 +8,10 @@
 //! from `x` (the recurrence drifts from it in floating point).
 //!
 //! Arnoldi by modified Gram–Schmidt, the Hessenberg least-squares problem by Givens
-//! rotations. The basis `V` (restart + 1 vectors) is allocated once per call; the
-//! preconditioner is applied once per iteration and once per restart cycle
-//! (`x += M⁻¹ V y`), so `M⁻¹ V` is never stored.
+//! rotations. The preconditioner is applied once per iteration: the preconditioned
+//! vectors `z_k = M⁻¹ v_k` are kept, so the update is `x += Z y` (a preconditioner
+//! application costs a pair of triangular solves, the vectors only memory). The
+//! vectors are allocated as the iterations first need them, once per call.
 
 /// Settings of [`gmres`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -69,10 +70,11 @@ pub fn gmres(
     }
     let m = settings.restart.max(1);
     let mut target = settings.tolerance * b_norm;
-    let mut v: Vec<Vec<f64>> = (0..=m).map(|_| vec![0.0; n]).collect();
+    let mut v: Vec<Vec<f64>> = vec![vec![0.0; n]];
+    let mut zs: Vec<Vec<f64>> = Vec::new();
     let mut h = vec![vec![0.0; m]; m + 1]; // h[i][k]
     let (mut cs, mut sn, mut g) = (vec![0.0; m], vec![0.0; m], vec![0.0; m + 1]);
-    let (mut w, mut z) = (vec![0.0; n], vec![0.0; n]);
+    let mut w = vec![0.0; n];
     let mut iterations = 0;
     loop {
         // r = b − A x
@@ -94,11 +96,17 @@ pub fn gmres(
         g[0] = beta;
         let mut k_done = 0;
         for k in 0..m {
-            // w = A M⁻¹ v_k
+            // z_k = M⁻¹ v_k, w = A z_k
+            if zs.len() <= k {
+                zs.push(vec![0.0; n]);
+            }
+            if v.len() <= k + 1 {
+                v.push(vec![0.0; n]);
+            }
             let (head, _) = v.split_at_mut(k + 1);
-            z.copy_from_slice(&head[k]);
-            precondition(&mut z)?;
-            apply(&z, &mut w);
+            zs[k].copy_from_slice(&head[k]);
+            precondition(&mut zs[k])?;
+            apply(&zs[k], &mut w);
             // modified Gram–Schmidt against v_0 … v_k
             for (i, vi) in head.iter().enumerate() {
                 let hik = dot(&w, vi);
@@ -133,21 +141,16 @@ pub fn gmres(
                 break;
             }
         }
-        // y = H⁻¹ g (upper triangular), x += M⁻¹ V y
+        // y = H⁻¹ g (upper triangular), x += Z y
         let mut y = vec![0.0; k_done];
         for i in (0..k_done).rev() {
             let s: f64 = ((i + 1)..k_done).map(|j| h[i][j] * y[j]).sum();
             y[i] = if h[i][i] != 0.0 { (g[i] - s) / h[i][i] } else { 0.0 };
         }
-        w.fill(0.0);
-        for (yi, vi) in y.iter().zip(&v) {
-            for (wj, vj) in w.iter_mut().zip(vi) {
-                *wj += yi * vj;
+        for (yi, zi) in y.iter().zip(&zs) {
+            for (xj, zj) in x.iter_mut().zip(zi) {
+                *xj += yi * zj;
             }
-        }
-        precondition(&mut w)?;
-        for (xj, wj) in x.iter_mut().zip(&w) {
-            *xj += wj;
         }
     }
 }

@@ -99,6 +99,8 @@ pub struct SolverTimings {
     pub n_krylov: usize,
     /// Solves an iterative backend handed to its direct fallback.
     pub n_fallback: usize,
+    /// `factor` calls that kept an earlier preconditioner instead of factoring.
+    pub n_reused: usize,
 }
 
 /// What the last `solve_in_place` did, for the log.
@@ -162,10 +164,15 @@ pub trait LinearSolver: Send {
     }
 }
 
+/// Widest supernode (columns) from which [`FaerDirect`] runs faer in parallel when
+/// its parallelism is left to it.
+pub const PARALLEL_SUPERNODE: usize = 2048;
+
 /// Options of [`FaerDirect`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FaerDirectOptions {
-    /// Parallelism passed to faer; `None` reads faer's global setting at each call.
+    /// Parallelism passed to faer; `None`: faer's global setting for a factor with a
+    /// supernode of at least [`PARALLEL_SUPERNODE`] columns, sequential below.
     pub par: Option<Par>,
     /// Which factorization a [`Symmetry::Symmetric`] matrix gets.
     pub symmetric: SymmetricStrategy,
@@ -272,8 +279,26 @@ impl FaerDirect {
         }
     }
 
+    /// Columns of the widest supernode of the Cholesky-type factor (0 if none).
+    pub fn largest_supernode(&self) -> usize {
+        match &self.symbolic {
+            Some(Symbolic::Cholesky(c)) => match c.raw() {
+                SymbolicCholeskyRaw::Supernodal(s) => s.supernode_begin().iter().zip(s.supernode_end()).map(|(b, e)| e - b).max().unwrap_or(0),
+                SymbolicCholeskyRaw::Simplicial(_) => 1,
+            },
+            _ => 0,
+        }
+    }
+
+    /// The parallelism of every faer call: the option's, else (auto) faer's global
+    /// setting for a factor whose widest supernode has at least
+    /// [`PARALLEL_SUPERNODE`] columns and `Par::Seq` below (on 2 cores the parallel
+    /// supernodal kernels lose to the sequential ones on narrower factors: the
+    /// crossed beams' 108k-dof factor, 14.5 s sequential against 19.5 s on 2
+    /// threads; the 30³ cube's, widest supernode 4,320, 2.9 s against 1.7 s;
+    /// `docs/performance.md`).
     fn par(&self) -> Par {
-        self.options.par.unwrap_or_else(faer::get_global_parallelism)
+        self.options.par.unwrap_or_else(|| if self.largest_supernode() >= PARALLEL_SUPERNODE { faer::get_global_parallelism() } else { Par::Seq })
     }
 
     fn factor_cholesky(&mut self, values: &[f64]) -> Result<Factorization, LinearSolverError> {
@@ -473,6 +498,23 @@ impl LinearSolver for FaerDirect {
     }
 
     fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolverError> {
+        self.solve(rhs)
+    }
+
+    fn timings(&self) -> SolverTimings {
+        self.timings_now()
+    }
+}
+
+impl FaerDirect {
+    /// The analysed pattern, if any.
+    pub fn pattern(&self) -> Option<&SymbolicSparseColMat<usize>> {
+        self.pattern.as_ref()
+    }
+
+    /// [`LinearSolver::solve_in_place`] without exclusive access (the factor is only
+    /// read), so that a preconditioner can solve while its owner is borrowed.
+    pub fn solve(&self, rhs: &mut [f64]) -> Result<(), LinearSolverError> {
         let start = Instant::now();
         let par = self.par();
         let n = match &self.pattern {
@@ -507,7 +549,7 @@ impl LinearSolver for FaerDirect {
         Ok(())
     }
 
-    fn timings(&self) -> SolverTimings {
+    fn timings_now(&self) -> SolverTimings {
         SolverTimings {
             symbolic: self.symbolic_time,
             numeric: self.numeric_time,
@@ -517,6 +559,7 @@ impl LinearSolver for FaerDirect {
             n_solve: self.n_solve.load(Ordering::Relaxed) as usize,
             n_krylov: 0,
             n_fallback: 0,
+            n_reused: 0,
         }
     }
 }

@@ -165,7 +165,9 @@ impl<'p> Newton<'p> {
         };
         let gmres = GmresSettings { tolerance: linear_setup.gmres_tolerance, max_iterations: linear_setup.gmres_max_iterations as usize, ..Default::default() };
         let mut linear: Box<dyn LinearSolver> = match (symmetry, choice) {
-            (Symmetry::General, LinearSolverChoice::Auto | LinearSolverChoice::Gmres) => Box::new(SymmetricPartGmres::new(gmres, direct)),
+            (Symmetry::General, LinearSolverChoice::Auto | LinearSolverChoice::Gmres) => {
+                Box::new(SymmetricPartGmres::with_reuse(gmres, direct, linear_setup.preconditioner_reuse as usize))
+            }
             _ => Box::new(FaerDirect::new(direct)),
         };
         linear.analyse(pattern.symbolic(), symmetry)?;

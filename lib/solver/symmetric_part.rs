@@ -43,17 +43,32 @@ pub struct SymmetricPartGmres {
     /// The LU fallback, analysed on first use.
     lu: FaerDirect,
     lu_analysed: bool,
-    pattern: Option<SymbolicSparseColMat<usize>>,
+    /// `analyse` succeeded (the pattern is held by `symmetric`, or by `lu` when
+    /// `transpose` is empty).
+    analysed: bool,
     /// `transpose[p]`: position of entry `(j, i)` for the entry `(i, j)` at `p`;
     /// empty when the pattern is not structurally symmetric (then only LU is used).
-    transpose: Vec<usize>,
-    /// `K` in the pattern's CSC order, and `Kᵀ` in it (that is, `K` by rows).
-    values: Vec<f64>,
+    /// (The pattern itself is the inner factorizations'.)
+    transpose: Vec<u32>,
+    /// `Kᵀ` in the pattern's CSC order, that is `K` by rows (the only copy of `K`
+    /// kept: `K[p] = values_t[transpose[p]]`); `K` itself when the pattern is not
+    /// structurally symmetric.
     values_t: Vec<f64>,
+    /// Scratch: `S` for its factorization, or `K` for the LU fallback.
     s_values: Vec<f64>,
     rhs: Vec<f64>,
     /// Why this factor's systems go to LU (`None`: the preconditioner holds).
     lu_reason: Option<String>,
+    /// Keep the held factorization of `S` while the last solve needed at most this
+    /// many GMRES iterations (0: factor every time).
+    reuse_below: usize,
+    /// The factorization of `S` held, if any (for this pattern), and whether it is of
+    /// the current values.
+    held: Option<Factorization>,
+    fresh: bool,
+    /// GMRES iterations of the last solve that converged (`usize::MAX`: none yet).
+    last_iterations: usize,
+    n_reused: usize,
     last: SolveReport,
     symbolic_time: Duration,
     numeric_time: Duration,
@@ -67,16 +82,26 @@ pub struct SymmetricPartGmres {
 
 impl SymmetricPartGmres {
     /// `direct`: the options of both factorizations (its `symmetric` strategy is
-    /// used for `S`).
+    /// used for `S`); `reuse_below`: see [`Self::reuse_below`].
     pub fn new(settings: GmresSettings, direct: FaerDirectOptions) -> Self {
+        Self::with_reuse(settings, direct, 0)
+    }
+
+    /// As [`Self::new`], keeping the factorization of `S` from one `factor` to the
+    /// next while the last solve took at most `reuse_below` GMRES iterations.
+    pub fn with_reuse(settings: GmresSettings, direct: FaerDirectOptions, reuse_below: usize) -> Self {
         Self {
+            reuse_below,
+            held: None,
+            fresh: false,
+            last_iterations: usize::MAX,
+            n_reused: 0,
             settings,
             symmetric: FaerDirect::new(direct),
             lu: FaerDirect::new(direct),
             lu_analysed: false,
-            pattern: None,
+            analysed: false,
             transpose: Vec::new(),
-            values: Vec::new(),
             values_t: Vec::new(),
             s_values: Vec::new(),
             rhs: Vec::new(),
@@ -93,14 +118,80 @@ impl SymmetricPartGmres {
         }
     }
 
+    /// Whether a pattern of `nnz` entries goes to LU alone (not structurally
+    /// symmetric: no transpose map).
+    fn general_pattern(&self, nnz: usize) -> bool {
+        self.transpose.is_empty() && nnz > 0
+    }
+
+    /// The analysed pattern (held by the inner factorization that uses it).
+    fn pattern(&self) -> Option<&SymbolicSparseColMat<usize>> {
+        if !self.analysed {
+            None
+        } else if self.transpose.is_empty() {
+            self.lu.pattern().or(self.symmetric.pattern())
+        } else {
+            self.symmetric.pattern()
+        }
+    }
+
+    /// GMRES on the stored `K` with the held factorization of `S`, right-hand side
+    /// `self.rhs`, solution into `x`.
+    fn run_gmres(&mut self, x: &mut [f64]) -> Result<super::gmres::GmresOutcome, String> {
+        let symmetric = &self.symmetric;
+        let pattern = symmetric.pattern().ok_or("no pattern")?;
+        let n = pattern.nrows();
+        let (cp, ri) = (pattern.col_ptr(), pattern.row_idx());
+        let values_t = &self.values_t;
+        // (K x)_i = Σ_j K_ij x_j: row i of K is column i of Kᵀ (structural symmetry).
+        let mut apply = |x: &[f64], out: &mut [f64]| {
+            out.par_iter_mut().enumerate().with_min_len(256).for_each(|(i, o)| {
+                *o = (cp[i]..cp[i + 1]).map(|p| values_t[p] * x[ri[p]]).sum();
+            });
+        };
+        let mut precondition = |v: &mut [f64]| symmetric.solve(v).map_err(|e| e.to_string());
+        // round-off floor of the residual: 64 ε ‖|K| |x|‖ (partial sums over fixed
+        // chunks, added in order: the same bits on any number of threads)
+        let mut floor = |x: &[f64]| {
+            const CHUNK: usize = 4096;
+            let partial: Vec<f64> = (0..n.div_ceil(CHUNK))
+                .into_par_iter()
+                .map(|c| (c * CHUNK..n.min((c + 1) * CHUNK)).map(|i| (cp[i]..cp[i + 1]).map(|p| (values_t[p] * x[ri[p]]).abs()).sum::<f64>().powi(2)).sum())
+                .collect();
+            64.0 * f64::EPSILON * partial.iter().sum::<f64>().sqrt()
+        };
+        gmres(&self.rhs, x, self.settings, &mut apply, &mut precondition, &mut floor)
+    }
+
+    /// Factor `S` of the stored values: `S[p] = (K[p] + Kᵀ[p]) / 2`.
+    fn factor_symmetric(&mut self) -> Result<Factorization, LinearSolverError> {
+        let vt = &self.values_t;
+        self.s_values.clear();
+        self.s_values.extend(self.transpose.iter().zip(vt).map(|(&q, at)| 0.5 * (vt[q as usize] + at)));
+        self.held = None;
+        let info = self.symmetric.factor(&self.s_values)?;
+        self.held = Some(info.method);
+        self.fresh = true;
+        self.n_numeric += 1;
+        Ok(info.method)
+    }
+
     /// Factor `K` (the stored values) by LU, for the reason given.
     fn factor_lu(&mut self, reason: String) -> Result<(), LinearSolverError> {
         if !self.lu_analysed {
-            let pattern = self.pattern.as_ref().ok_or(LinearSolverError::Order("factor", "analyse"))?;
+            let pattern = self.symmetric.pattern().ok_or(LinearSolverError::Order("factor", "analyse"))?.clone();
             self.lu.analyse(pattern.as_ref(), Symmetry::General)?;
             self.lu_analysed = true;
         }
-        self.lu.factor(&self.values)?;
+        if self.transpose.is_empty() {
+            self.lu.factor(&self.values_t)?;
+        } else {
+            let vt = &self.values_t;
+            self.s_values.clear();
+            self.s_values.extend(self.transpose.iter().map(|&q| vt[q as usize]));
+            self.lu.factor(&self.s_values)?;
+        }
+        self.n_numeric += 1;
         self.lu_reason = Some(reason);
         Ok(())
     }
@@ -108,9 +199,13 @@ impl SymmetricPartGmres {
 
 /// Positions of the transposed entries of a square CSC pattern with sorted rows, or
 /// `None` when it is not structurally symmetric.
-pub fn transpose_positions(pattern: SymbolicSparseColMatRef<'_, usize>) -> Option<Vec<usize>> {
+/// (Positions are `u32`: a pattern of more entries is treated as not symmetric.)
+pub fn transpose_positions(pattern: SymbolicSparseColMatRef<'_, usize>) -> Option<Vec<u32>> {
     let (cp, ri) = (pattern.col_ptr(), pattern.row_idx());
     let n = pattern.ncols();
+    if ri.len() > u32::MAX as usize {
+        return None;
+    }
     let mut next: Vec<usize> = cp[..n].to_vec();
     let mut transpose = vec![0; ri.len()];
     // Columns visited in increasing j reach the entries of row j of each column i
@@ -122,7 +217,7 @@ pub fn transpose_positions(pattern: SymbolicSparseColMatRef<'_, usize>) -> Optio
             if q >= cp[i + 1] || ri[q] != j {
                 return None;
             }
-            transpose[p] = q;
+            transpose[p] = q as u32;
             next[i] += 1;
         }
     }
@@ -136,25 +231,29 @@ impl LinearSolver for SymmetricPartGmres {
 
     fn analyse(&mut self, pattern: SymbolicSparseColMatRef<'_, usize>, symmetry: Symmetry) -> Result<(), LinearSolverError> {
         let start = Instant::now();
+        self.analysed = false;
+        self.held = None;
+        self.last_iterations = usize::MAX;
         self.lu_analysed = false;
         self.lu_reason = None;
-        let owned = pattern.to_owned().map_err(|e| LinearSolverError::Faer(format!("{e:?}")))?;
-        self.transpose = transpose_positions(owned.as_ref()).unwrap_or_default();
-        if !self.transpose.is_empty() || owned.row_idx().is_empty() {
-            self.symmetric.analyse(owned.as_ref(), Symmetry::Symmetric)?;
-        }
-        if symmetry == Symmetry::General && self.transpose.is_empty() && !owned.row_idx().is_empty() {
-            self.lu.analyse(owned.as_ref(), Symmetry::General)?;
+        let _ = symmetry; // K is treated as general whatever it is declared
+        self.transpose = transpose_positions(pattern).unwrap_or_default();
+        // the inner factorizations own the pattern: S's, or LU's when the pattern is
+        // not structurally symmetric
+        if self.general_pattern(pattern.row_idx().len()) {
+            self.lu.analyse(pattern, Symmetry::General)?;
             self.lu_analysed = true;
+        } else {
+            self.symmetric.analyse(pattern, Symmetry::Symmetric)?;
         }
-        self.pattern = Some(owned);
+        self.analysed = true;
         self.symbolic_time += start.elapsed();
         self.n_symbolic += 1;
         Ok(())
     }
 
     fn factor(&mut self, values: &[f64]) -> Result<FactorInfo, LinearSolverError> {
-        let Some(pattern) = &self.pattern else {
+        let Some(pattern) = self.pattern() else {
             return Err(LinearSolverError::Order("factor", "analyse"));
         };
         let nnz = pattern.row_idx().len();
@@ -165,34 +264,39 @@ impl LinearSolver for SymmetricPartGmres {
             return Err(LinearSolverError::NonFinite { index });
         }
         let start = Instant::now();
-        self.values.clear();
-        self.values.extend_from_slice(values);
         self.lu_reason = None;
         let method = if self.transpose.is_empty() && nnz > 0 {
+            self.values_t.clear();
+            self.values_t.extend_from_slice(values);
             self.factor_lu("the pattern is not structurally symmetric".into())?;
             Factorization::Lu
         } else {
             let t = &self.transpose;
             self.values_t.clear();
-            self.values_t.extend(t.iter().map(|&q| values[q]));
-            self.s_values.clear();
-            self.s_values.extend(values.iter().zip(&self.values_t).map(|(a, at)| 0.5 * (a + at)));
-            match self.symmetric.factor(&self.s_values) {
-                Ok(info) => info.method,
-                Err(e) => {
-                    self.factor_lu(format!("the symmetric part could not be factored ({e})"))?;
-                    Factorization::Lu
+            self.values_t.extend(t.iter().map(|&q| values[q as usize]));
+            match self.held {
+                // the last solve converged quickly: the held S still preconditions well
+                Some(method) if self.last_iterations <= self.reuse_below => {
+                    self.fresh = false;
+                    self.n_reused += 1;
+                    method
                 }
+                _ => match self.factor_symmetric() {
+                    Ok(method) => method,
+                    Err(e) => {
+                        self.factor_lu(format!("the symmetric part could not be factored ({e})"))?;
+                        Factorization::Lu
+                    }
+                },
             }
         };
         let time = start.elapsed();
         self.numeric_time += time;
-        self.n_numeric += 1;
         Ok(FactorInfo { method, time })
     }
 
     fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolverError> {
-        let Some(pattern) = &self.pattern else {
+        let Some(pattern) = self.pattern() else {
             return Err(LinearSolverError::Order("solve_in_place", "analyse"));
         };
         let n = pattern.nrows();
@@ -209,46 +313,41 @@ impl LinearSolver for SymmetricPartGmres {
         }
         self.rhs.clear();
         self.rhs.extend_from_slice(rhs);
-        let (cp, ri) = (pattern.col_ptr(), pattern.row_idx());
-        let values_t = &self.values_t;
-        // (K x)_i = Σ_j K_ij x_j: row i of K is column i of Kᵀ (structural symmetry).
-        let mut apply = |x: &[f64], out: &mut [f64]| {
-            out.par_iter_mut().enumerate().with_min_len(256).for_each(|(i, o)| {
-                *o = (cp[i]..cp[i + 1]).map(|p| values_t[p] * x[ri[p]]).sum();
-            });
-        };
-        let symmetric = &mut self.symmetric;
-        let mut precondition = |v: &mut [f64]| symmetric.solve_in_place(v).map_err(|e| e.to_string());
-        // round-off floor of the residual: 64 ε ‖|K| |x|‖
-        // (partial sums over fixed chunks, added in order: the same bits on any
-        // number of threads)
-        let mut floor = |x: &[f64]| {
-            const CHUNK: usize = 4096;
-            let partial: Vec<f64> = (0..n.div_ceil(CHUNK))
-                .into_par_iter()
-                .map(|c| (c * CHUNK..n.min((c + 1) * CHUNK)).map(|i| (cp[i]..cp[i + 1]).map(|p| (values_t[p] * x[ri[p]]).abs()).sum::<f64>().powi(2)).sum())
-                .collect();
-            64.0 * f64::EPSILON * partial.iter().sum::<f64>().sqrt()
-        };
-        let outcome = gmres(&self.rhs, rhs, self.settings, &mut apply, &mut precondition, &mut floor);
+        let mut outcome = self.run_gmres(rhs);
+        let mut iterations = outcome.as_ref().map_or(0, |o| o.iterations);
+        if !matches!(outcome, Ok(o) if o.converged) && !self.fresh {
+            // a held factorization of an earlier S: factor the current one and retry
+            let t = Instant::now();
+            let refactored = self.factor_symmetric();
+            self.numeric_time += t.elapsed();
+            if refactored.is_ok() {
+                outcome = self.run_gmres(rhs);
+                iterations += outcome.as_ref().map_or(0, |o| o.iterations);
+            }
+        }
+        self.n_krylov += iterations;
         let result = match outcome {
             Ok(o) if o.converged => {
-                self.n_krylov += o.iterations;
-                self.last = SolveReport { krylov_iterations: o.iterations, fallback: None };
+                self.last_iterations = iterations;
+                self.last = SolveReport { krylov_iterations: iterations, fallback: None };
                 Ok(())
             }
             other => {
                 let why = match other {
-                    Ok(o) => {
-                        self.n_krylov += o.iterations;
-                        format!("GMRES preconditioned by the symmetric part reached a relative residual of {:.2e} in {} iterations (tolerance {:.0e})", o.relative_residual, o.iterations, self.settings.tolerance)
-                    }
+                    Ok(o) => format!(
+                        "GMRES preconditioned by the symmetric part reached a relative residual of {:.2e} in {} iterations (tolerance {:.0e})",
+                        o.relative_residual, iterations, self.settings.tolerance
+                    ),
                     Err(e) => format!("the symmetric part's solve failed ({e})"),
                 };
+                self.last_iterations = usize::MAX;
                 self.n_fallback += 1;
-                self.factor_lu(why.clone())?;
+                let t = Instant::now();
+                let factored = self.factor_lu(why.clone());
+                self.numeric_time += t.elapsed();
+                factored?;
                 rhs.copy_from_slice(&self.rhs);
-                self.last = SolveReport { krylov_iterations: 0, fallback: Some(why) };
+                self.last = SolveReport { krylov_iterations: iterations, fallback: Some(why) };
                 self.lu.solve_in_place(rhs)
             }
         };
@@ -266,6 +365,7 @@ impl LinearSolver for SymmetricPartGmres {
             n_solve: self.n_solve,
             n_krylov: self.n_krylov,
             n_fallback: self.n_fallback,
+            n_reused: self.n_reused,
         }
     }
 
@@ -292,7 +392,7 @@ mod tests {
                 let i = p.row_idx()[q];
                 if i < j && i % 3 == 0 && j % 3 == 1 {
                     v[q] += skew * scale;
-                    v[t[q]] -= skew * scale;
+                    v[t[q] as usize] -= skew * scale;
                 }
             }
         }
@@ -306,10 +406,10 @@ mod tests {
         for j in 0..p.ncols() {
             for q in p.col_ptr()[j]..p.col_ptr()[j + 1] {
                 let i = p.row_idx()[q];
-                let back = t[q];
+                let back = t[q] as usize;
                 assert_eq!(p.row_idx()[back], j);
                 assert!(p.col_ptr()[i] <= back && back < p.col_ptr()[i + 1]);
-                assert_eq!(t[back], q);
+                assert_eq!(t[back] as usize, q);
             }
         }
         // A pattern with (1, 0) but not (0, 1) is not structurally symmetric.
@@ -359,6 +459,54 @@ mod tests {
         // The next factorization tries the preconditioner again.
         s.factor(&v).unwrap();
         assert!(s.lu_reason.is_none());
+    }
+
+    fn residual(p: &SymbolicSparseColMat<usize>, v: &[f64], x: &[f64], b: &[f64]) -> f64 {
+        relative_residual(p.col_ptr(), p.row_idx(), v, x, b)
+    }
+
+    #[test]
+    fn keeps_the_factorization_while_gmres_converges_quickly() {
+        let (p, v, b) = skewed(0.002);
+        let mut s = SymmetricPartGmres::with_reuse(GmresSettings { max_iterations: 15, ..Default::default() }, FaerDirectOptions::default(), 15);
+        s.analyse(p.as_ref(), Symmetry::General).unwrap();
+        s.factor(&v).unwrap();
+        let mut x = b.clone();
+        s.solve_in_place(&mut x).unwrap();
+        assert!(s.fresh && s.last_solve().fallback.is_none() && s.last_solve().krylov_iterations <= 15, "{:?}", s.last_solve());
+        // a nearby tangent: the held S preconditions it; the solution is K₂'s
+        let v2: Vec<f64> = v.iter().map(|a| 1.02 * a).collect();
+        s.factor(&v2).unwrap();
+        assert!(!s.fresh);
+        let mut x = b.clone();
+        s.solve_in_place(&mut x).unwrap();
+        assert!(residual(&p, &v2, &x, &b) <= 1e-12 && s.last_solve().fallback.is_none());
+        let t = s.timings();
+        assert_eq!((t.n_numeric, t.n_reused), (1, 1));
+        // a far one: the stale S misses the budget, S is factored anew and GMRES
+        // converges (no LU)
+        let mut v3 = v.clone();
+        for j in 0..p.ncols() {
+            let (lo, hi) = (p.col_ptr()[j], p.col_ptr()[j + 1]);
+            let d = lo + p.row_idx()[lo..hi].binary_search(&j).unwrap();
+            v3[d] *= if j % 2 == 0 { 50.0 } else { 0.6 };
+        }
+        s.factor(&v3).unwrap();
+        let mut x = b.clone();
+        s.solve_in_place(&mut x).unwrap();
+        let t = s.timings();
+        assert!(residual(&p, &v3, &x, &b) <= 1e-12, "{:?}", s.last_solve());
+        assert_eq!((t.n_numeric, t.n_reused, t.n_fallback), (2, 2, 0), "{t:?}");
+        assert!(s.fresh);
+        // reuse 0: every factor() factors
+        let mut every = SymmetricPartGmres::new(GmresSettings::default(), FaerDirectOptions::default());
+        every.analyse(p.as_ref(), Symmetry::General).unwrap();
+        for vals in [&v, &v2] {
+            every.factor(vals).unwrap();
+            let mut x = b.clone();
+            every.solve_in_place(&mut x).unwrap();
+        }
+        assert_eq!((every.timings().n_numeric, every.timings().n_reused), (2, 0));
     }
 
     #[test]

@@ -155,7 +155,13 @@ pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, 
         t.n_solve,
         t.solve.as_secs_f64(),
         if t.n_krylov > 0 || t.n_fallback > 0 {
-            format!(", {} GMRES iterations ({:.1} per solve), {} solved by the LU fallback", t.n_krylov, t.n_krylov as f64 / t.n_solve.max(1) as f64, t.n_fallback)
+            format!(
+                ", {} GMRES iterations ({:.1} per solve), {} preconditioners kept from the iteration before, {} solved by the LU fallback",
+                t.n_krylov,
+                t.n_krylov as f64 / t.n_solve.max(1) as f64,
+                t.n_reused,
+                t.n_fallback
+            )
         } else {
             String::new()
         }

@@ -7,3 +7,4 @@ mod paper_examples;
 mod ironing;
 mod shallow_ironing;
 mod sliding;
+mod ccx_compare;
