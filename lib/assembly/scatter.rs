@@ -204,6 +204,34 @@ impl Assembly {
         })
     }
 
+    /// A workspace for no pattern (holds nothing): what an owner keeps while it
+    /// drops the old workspace before building the next, so that the two never
+    /// live at once.
+    pub fn empty() -> Self {
+        Self {
+            n_hex: 0,
+            n_groups: 0,
+            nnz: 0,
+            k_hex: Vec::new(),
+            r_hex: Vec::new(),
+            k_grp: Vec::new(),
+            r_grp: Vec::new(),
+            hex_to_slot: Contributions::default(),
+            grp_to_slot: Contributions::default(),
+            hex_to_dof: Contributions::default(),
+            grp_to_dof: Contributions::default(),
+            values: Vec::new(),
+            residual: Vec::new(),
+            timings: AssemblyTimings::default(),
+        }
+    }
+
+    /// Whether this workspace was built for `pattern` (its element, group and entry
+    /// counts).
+    pub fn fits(&self, pattern: &Pattern) -> bool {
+        pattern.hexes().len() == self.n_hex && pattern.groups().len() == self.n_groups && pattern.nnz() == self.nnz && self.values.len() == self.nnz
+    }
+
     /// Assembles hexahedra only (contact groups, if any, contribute zero).
     ///
     /// `element(e, r_e, k_e)` fills the (zeroed) residual and tangent of hexahedron
@@ -237,12 +265,7 @@ impl Assembly {
         F: Fn(usize, &mut HexVector, &mut HexMatrix) -> Result<(), E> + Sync,
         G: Fn(usize, &mut DVector<f64>, &mut DMatrix<f64>) -> Result<(), E> + Sync,
     {
-        assert!(
-            pattern.hexes().len() == self.n_hex
-                && pattern.groups().len() == self.n_groups
-                && pattern.nnz() == self.nnz,
-            "Assembly workspace used with a different pattern than it was built for"
-        );
+        assert!(self.fits(pattern), "Assembly workspace used with a different pattern than it was built for");
         // Phase 1: element contributions into private buffers.
         let start = std::time::Instant::now();
         let hex_failure = self

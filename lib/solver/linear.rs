@@ -418,8 +418,7 @@ impl LinearSolver for FaerDirect {
             return Err(LinearSolverError::Dimension { what: "columns (square matrix)", expected: n, got: pattern.ncols() });
         }
         let start = Instant::now();
-        self.numeric = Numeric::None;
-        self.symbolic = None;
+        self.release();
         let owned = pattern.to_owned().map_err(|e| LinearSolverError::Faer(format!("{e:?}")))?;
         self.diag_pos = (0..n)
             .map(|j| {
@@ -507,6 +506,16 @@ impl LinearSolver for FaerDirect {
 }
 
 impl FaerDirect {
+    /// Drops the pattern, the analysis and the factor (their memory), as a new
+    /// `analyse` would before building its own.
+    pub fn release(&mut self) {
+        self.numeric = Numeric::None;
+        self.symbolic = None;
+        self.pattern = None;
+        self.diag_pos = Vec::new();
+        self.l_values = Vec::new();
+    }
+
     /// The analysed pattern, if any.
     pub fn pattern(&self) -> Option<&SymbolicSparseColMat<usize>> {
         self.pattern.as_ref()

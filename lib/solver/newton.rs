@@ -206,10 +206,13 @@ impl<'p> Newton<'p> {
         let fail = |message: String| IncrementFailure::ContactSetup { iteration, message };
         let mut groups = std::mem::take(&mut self.group_scratch);
         contact_groups(self.problem, &mut self.contact, u, &mut groups, &mut self.owners).map_err(|e| fail(e.to_string()))?;
-        if &groups == self.pattern.groups() {
+        if &groups == self.pattern.groups() && self.assembly.fits(&self.pattern) {
             self.group_scratch = groups;
         } else {
             self.pattern = self.pattern.with_groups(groups).map_err(|e| fail(e.to_string()))?;
+            // the old workspace goes before the new one is built (peak memory); a
+            // failure leaves the empty one, which `fits` no pattern: rebuilt next time
+            self.assembly = Assembly::empty();
             self.assembly = Assembly::new(&self.pattern).map_err(|e| fail(e.to_string()))?;
             self.linear.analyse(self.pattern.symbolic(), self.symmetry).map_err(|error| IncrementFailure::Linear { iteration, error })?;
             self.pattern_rebuilds += 1;

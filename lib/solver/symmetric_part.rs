@@ -237,6 +237,10 @@ impl LinearSolver for SymmetricPartGmres {
         self.lu_analysed = false;
         self.lu_reason = None;
         let _ = symmetry; // K is treated as general whatever it is declared
+        // the old pattern's arrays and factors go first (peak memory)
+        self.symmetric.release();
+        self.lu.release();
+        (self.transpose, self.values_t, self.s_values) = (Vec::new(), Vec::new(), Vec::new());
         self.transpose = transpose_positions(pattern).unwrap_or_default();
         // the inner factorizations own the pattern: S's, or LU's when the pattern is
         // not structurally symmetric
