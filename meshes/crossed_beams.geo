@@ -1,7 +1,7 @@
 // Crossed beams (Santos & Bandeira 2018, sec. 7.2): two beams crossed and superposed
 // with a 0.2 mm gap; the upper beam is a cantilever loaded at the edge of its free end
 // and pressed onto the lower beam, which is clamped at both ends.
-// Topology from /work/shared/benchmarks.md: each beam 2 x 2 x 15 hex8 (3 x 3 x 16 = 144
+// Topology of the paper's example (docs/validation.md): each beam 2 x 2 x 15 hex8 (3 x 3 x 16 = 144
 // nodes): 288 nodes, 120 elements. The paper's figure with the dimensions is lost, so
 // these dimensions are OURS (unit system: mm, N, MPa = N/mm^2):
 //   upper beam  (cantilever, along x)  x in [0, 150],  y in [-5, 5],   z in [10.2, 20.2]

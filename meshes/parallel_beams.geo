@@ -2,7 +2,7 @@
 // restrained (clamped) at both ends, one above the other with a gap; line loads press
 // them towards each other (down on the upper beam's top, up under the lower beam), so
 // both arch before they touch and the contact surfaces are curved.
-// Topology from /work/shared/benchmarks.md: lower 2 x 2 x 15 hex8 (144 nodes), upper
+// Topology of the paper's example (docs/validation.md): lower 2 x 2 x 15 hex8 (144 nodes), upper
 // 4 x 2 x 15 hex8 (5 x 3 x 16 = 240 nodes): 384 nodes, 180 elements. The upper beam is
 // twice as wide, otherwise the same size (paper). The paper's figure with the
 // dimensions, supports and load positions is lost, so these are OURS (unit system:

@@ -1,5 +1,5 @@
 // Parisch (1989) two-block contact example, as used by Santos & Bandeira (2018), sec. 7.1.
-// Topology from ../shared/benchmarks.md: lower block 3x3x1 hex8 (32 nodes), upper block
+// Topology of the paper's example (docs/validation.md): lower block 3x3x1 hex8 (32 nodes), upper block
 // 2x2x1 hex8 (18 nodes): 50 nodes, 13 elements. The paper's figure with the dimensions is
 // lost, so these dimensions are OURS (unit system: mm, N, MPa):
 //   lower block  x,y in [-15, 15], z in [0, 10]

@@ -1,7 +1,7 @@
 // Supported beam (Santos & Bandeira 2018, sec. 7.4): a cantilever suspended 0.5 mm
 // over a beam fixed at both ends; loads on the nodes of the cantilever's free end bend
 // it down onto the lower beam, which then bends too.
-// Topology from /work/shared/benchmarks.md: upper 2 x 3 x 20 hex8 (3 x 4 x 21 = 252
+// Topology of the paper's example (docs/validation.md): upper 2 x 3 x 20 hex8 (3 x 4 x 21 = 252
 // nodes; its end face has the 12 loaded nodes), lower 2 x 2 x 20 hex8 (3 x 3 x 21 =
 // 189 nodes): 441 nodes, 200 elements. The paper's figure with the dimensions is lost,
 // so these dimensions are OURS (unit system: mm, N, MPa = N/mm^2):

@@ -266,6 +266,10 @@ pub struct LinearSolverSetup {
     /// iteration while a solve needs at most this many iterations (0: factor every
     /// iteration).
     pub preconditioner_reuse: u32,
+    /// Inexact Newton: each GMRES solve stops at η = min(1e-3, 1e-2 r) relative to
+    /// its right-hand side, r being Newton's relative residual (never below
+    /// `gmres_tolerance`); `false`: every solve to `gmres_tolerance`.
+    pub inexact_newton: bool,
 }
 
 impl Default for LinearSolverSetup {
@@ -276,6 +280,7 @@ impl Default for LinearSolverSetup {
             gmres_tolerance: 1e-12,
             gmres_max_iterations: 100,
             preconditioner_reuse: 8,
+            inexact_newton: true,
         }
     }
 }
@@ -297,6 +302,7 @@ struct LinearSolverMap {
     gmres_tolerance: Option<f64>,
     gmres_max_iterations: Option<u32>,
     preconditioner_reuse: Option<u32>,
+    inexact_newton: Option<bool>,
 }
 
 impl<'de> Deserialize<'de> for LinearSolverSetup {
@@ -305,7 +311,7 @@ impl<'de> Deserialize<'de> for LinearSolverSetup {
         impl<'de> serde::de::Visitor<'de> for Visitor {
             type Value = LinearSolverSetup;
             fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-                f.write_str("a method (auto, cholesky, ldlt, lu, gmres) or a map with keys method, ordering, gmres_tolerance, gmres_max_iterations, preconditioner_reuse")
+                f.write_str("a method (auto, cholesky, ldlt, lu, gmres) or a map with keys method, ordering, gmres_tolerance, gmres_max_iterations, preconditioner_reuse, inexact_newton")
             }
             fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<Self::Value, E> {
                 let method = LinearSolverChoice::deserialize(serde::de::value::StrDeserializer::<E>::new(v))?;
@@ -324,6 +330,7 @@ impl<'de> Deserialize<'de> for LinearSolverSetup {
                     gmres_tolerance: tolerance,
                     gmres_max_iterations: m.gmres_max_iterations.unwrap_or(d.gmres_max_iterations),
                     preconditioner_reuse: m.preconditioner_reuse.unwrap_or(d.preconditioner_reuse),
+                    inexact_newton: m.inexact_newton.unwrap_or(d.inexact_newton),
                 })
             }
         }

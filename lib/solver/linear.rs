@@ -18,9 +18,11 @@
 //! dissection or AMD ordering ([`super::ordering`]), supernodal) for the symmetric positive definite tangent; when it
 //! meets a non-positive pivot, `LDLᵀ` on the same symbolic factorization
 //! (symmetric indefinite, no pivoting: fails only on a zero pivot).
-//! [`Symmetry::General`]: `LU` with partial pivoting (COLAMD ordering), for the
-//! non-symmetric tangent of friction; 5–10× slower and 4–7× the memory of `LLᵀ`
-//! on hex8 elasticity (see `/work/shared/toolchain.md`).
+//! [`Symmetry::General`]: `LU` with partial pivoting (COLAMD ordering). On 3D
+//! meshes its fill explodes (the frictional crossed beams at 109k dofs: 24 s and
+//! 8.2 GB for one LU), so the frictional tangent goes by default to
+//! [`super::symmetric_part::SymmetricPartGmres`], which factors only the symmetric
+//! part and keeps this LU as its fallback (`docs/performance.md`).
 //!
 //! **Singularity.** faer reports exact zero / non-positive pivots; a body that is
 //! not held (rigid modes) usually produces a pivot that is only round-off small
@@ -32,8 +34,10 @@
 //!
 //! **Threads and determinism.** The library never calls
 //! `faer::set_global_parallelism`. Parallelism is
-//! [`FaerDirectOptions::par`]: `None` uses faer's global setting (default: all
-//! rayon threads), `Some(par)` passes `par` explicitly to every faer call. For
+//! [`FaerDirectOptions::par`]: `None` runs faer sequentially on factors whose widest
+//! supernode is narrower than [`PARALLEL_SUPERNODE`] and with faer's global setting
+//! (default: all rayon threads) above, `Some(par)` passes `par` explicitly to every
+//! faer call. For
 //! bit-identical reruns fix it (`Par::Seq`, or `Par::rayon(n)` with a fixed `n`):
 //! faer's blocked kernels may split work differently for different thread counts.
 
@@ -162,6 +166,9 @@ pub trait LinearSolver: Send {
     fn last_solve(&self) -> SolveReport {
         SolveReport::default()
     }
+    /// The relative residual the next solves may stop at, for an iterative
+    /// backend (an inexact Newton's forcing term); a direct backend ignores it.
+    fn set_forcing(&mut self, _eta: f64) {}
 }
 
 /// Widest supernode (columns) from which [`FaerDirect`] runs faer in parallel when

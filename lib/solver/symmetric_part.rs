@@ -38,6 +38,8 @@ use super::linear::{FactorInfo, FaerDirect, FaerDirectOptions, Factorization, Li
 /// GMRES on `K`, preconditioned by the factorization of `(K + Kᵀ)/2`.
 pub struct SymmetricPartGmres {
     settings: GmresSettings,
+    /// The tolerance of the settings, below which a forcing term never goes.
+    base_tolerance: f64,
     /// Factors the symmetric part.
     symmetric: FaerDirect,
     /// The LU fallback, analysed on first use.
@@ -96,6 +98,7 @@ impl SymmetricPartGmres {
             fresh: false,
             last_iterations: usize::MAX,
             n_reused: 0,
+            base_tolerance: settings.tolerance,
             settings,
             symmetric: FaerDirect::new(direct),
             lu: FaerDirect::new(direct),
@@ -376,6 +379,10 @@ impl LinearSolver for SymmetricPartGmres {
     fn last_solve(&self) -> SolveReport {
         self.last.clone()
     }
+
+    fn set_forcing(&mut self, eta: f64) {
+        self.settings.tolerance = if eta.is_finite() { eta.clamp(self.base_tolerance, 0.5) } else { self.base_tolerance };
+    }
 }
 
 #[cfg(test)]
@@ -511,6 +518,29 @@ mod tests {
             every.solve_in_place(&mut x).unwrap();
         }
         assert_eq!((every.timings().n_numeric, every.timings().n_reused), (2, 0));
+    }
+
+    #[test]
+    fn a_forcing_term_loosens_the_solve_but_never_below_the_base_tolerance() {
+        let (p, v, b) = skewed(0.01);
+        let solve = |eta: Option<f64>| {
+            let mut s = SymmetricPartGmres::new(GmresSettings::default(), FaerDirectOptions::default());
+            s.analyse(p.as_ref(), Symmetry::General).unwrap();
+            s.factor(&v).unwrap();
+            if let Some(eta) = eta {
+                s.set_forcing(eta);
+            }
+            let mut x = b.clone();
+            s.solve_in_place(&mut x).unwrap();
+            (residual(&p, &v, &x, &b), s.last_solve().krylov_iterations)
+        };
+        let (r_tight, its_tight) = solve(None);
+        let (r_loose, its_loose) = solve(Some(1e-3));
+        assert!(r_tight <= 1e-12 && r_loose <= 1e-3 && its_loose < its_tight, "{r_tight:e} {its_tight}, {r_loose:e} {its_loose}");
+        // a forcing term below the base tolerance, or not finite, gives the base one
+        for eta in [1e-20, f64::NAN] {
+            assert!(solve(Some(eta)).0 <= 1e-12);
+        }
     }
 
     #[test]
