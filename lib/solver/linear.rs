@@ -384,6 +384,20 @@ impl FaerDirect {
     }
 }
 
+/// The checks every `factor(values)` makes: a pattern was analysed, `values` has one
+/// finite entry per pattern entry. Returns the pattern.
+pub fn check_values<'a>(pattern: Option<&'a SymbolicSparseColMat<usize>>, values: &[f64]) -> Result<&'a SymbolicSparseColMat<usize>, LinearSolverError> {
+    let pattern = pattern.ok_or(LinearSolverError::Order("factor", "analyse"))?;
+    let nnz = pattern.row_idx().len();
+    if values.len() != nnz {
+        return Err(LinearSolverError::Dimension { what: "values (pattern entries)", expected: nnz, got: values.len() });
+    }
+    if let Some(index) = values.iter().position(|v| !v.is_finite()) {
+        return Err(LinearSolverError::NonFinite { index });
+    }
+    Ok(pattern)
+}
+
 /// Diagonal of a Cholesky-type factor in the permuted order: `L_jj` for `LLᵀ`,
 /// `D_jj` for `LDLᵀ` (both are stored on the factor's diagonal).
 fn factor_diagonal(sym: &SymbolicCholesky<usize>, values: &[f64]) -> Vec<f64> {
@@ -461,16 +475,7 @@ impl LinearSolver for FaerDirect {
     }
 
     fn factor(&mut self, values: &[f64]) -> Result<FactorInfo, LinearSolverError> {
-        let Some(pattern) = &self.pattern else {
-            return Err(LinearSolverError::Order("factor", "analyse"));
-        };
-        let nnz = pattern.row_idx().len();
-        if values.len() != nnz {
-            return Err(LinearSolverError::Dimension { what: "values (pattern entries)", expected: nnz, got: values.len() });
-        }
-        if let Some(index) = values.iter().position(|v| !v.is_finite()) {
-            return Err(LinearSolverError::NonFinite { index });
-        }
+        let pattern = check_values(self.pattern.as_ref(), values)?;
         let start = Instant::now();
         self.numeric = Numeric::None;
         let result = match &self.symbolic {

@@ -33,7 +33,7 @@ use faer::sparse::{SymbolicSparseColMat, SymbolicSparseColMatRef};
 use rayon::prelude::*;
 
 use super::gmres::{gmres, GmresSettings};
-use super::linear::{FactorInfo, FaerDirect, FaerDirectOptions, Factorization, LinearSolver, LinearSolverError, SolveReport, SolverTimings, Symmetry};
+use super::linear::{check_values, FactorInfo, FaerDirect, FaerDirectOptions, Factorization, LinearSolver, LinearSolverError, SolveReport, SolverTimings, Symmetry};
 
 /// GMRES on `K`, preconditioned by the factorization of `(K + Kᵀ)/2`.
 pub struct SymmetricPartGmres {
@@ -260,16 +260,7 @@ impl LinearSolver for SymmetricPartGmres {
     }
 
     fn factor(&mut self, values: &[f64]) -> Result<FactorInfo, LinearSolverError> {
-        let Some(pattern) = self.pattern() else {
-            return Err(LinearSolverError::Order("factor", "analyse"));
-        };
-        let nnz = pattern.row_idx().len();
-        if values.len() != nnz {
-            return Err(LinearSolverError::Dimension { what: "values (pattern entries)", expected: nnz, got: values.len() });
-        }
-        if let Some(index) = values.iter().position(|v| !v.is_finite()) {
-            return Err(LinearSolverError::NonFinite { index });
-        }
+        let nnz = check_values(self.pattern(), values)?.row_idx().len();
         let start = Instant::now();
         self.lu_reason = None;
         let method = if self.transpose.is_empty() && nnz > 0 {
