@@ -25,6 +25,8 @@ use splinecontact::stages::solve;
 ///                  penetration_tolerance: 1.0e-4, max_augmentations: 20}]
 ///   increments:  {count: 10, max_cutbacks: 5}
 ///   newton:      {max_iterations: 25, residual_tolerance: 1.0e-8, energy_tolerance: 1.0e-12}
+///   linear_solver: auto   # Cholesky (nested dissection); with friction GMRES
+///                         # preconditioned by the symmetric part (LU fallback)
 ///
 /// eps_n is a pressure per unit penetration (times each slave node's tributary area).
 /// A body held only by contact must start touching its master or be supported, and
