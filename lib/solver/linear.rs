@@ -232,6 +232,9 @@ pub struct FaerDirect {
     numeric: Numeric,
     /// Values of the Cholesky-type factor.
     l_values: Vec<f64>,
+    /// Columns of the widest supernode of the Cholesky-type symbolic factor (0 for
+    /// none or LU): decides the automatic parallelism ([`PARALLEL_SUPERNODE`]).
+    widest_supernode: usize,
     symbolic_time: Duration,
     numeric_time: Duration,
     n_symbolic: usize,
@@ -255,6 +258,7 @@ impl FaerDirect {
             symbolic: None,
             numeric: Numeric::None,
             l_values: Vec::new(),
+            widest_supernode: 0,
             symbolic_time: Duration::ZERO,
             numeric_time: Duration::ZERO,
             n_symbolic: 0,
@@ -286,15 +290,10 @@ impl FaerDirect {
         }
     }
 
-    /// Columns of the widest supernode of the Cholesky-type factor (0 if none).
+    /// Columns of the widest supernode of the Cholesky-type factor (0 if none; set
+    /// by `analyse`).
     pub fn largest_supernode(&self) -> usize {
-        match &self.symbolic {
-            Some(Symbolic::Cholesky(c)) => match c.raw() {
-                SymbolicCholeskyRaw::Supernodal(s) => s.supernode_begin().iter().zip(s.supernode_end()).map(|(b, e)| e - b).max().unwrap_or(0),
-                SymbolicCholeskyRaw::Simplicial(_) => 1,
-            },
-            _ => 0,
-        }
+        self.widest_supernode
     }
 
     /// The parallelism of every faer call: the option's, else (auto) faer's global
@@ -305,7 +304,7 @@ impl FaerDirect {
     /// threads; the 30³ cube's, widest supernode 4,320, 2.9 s against 1.7 s;
     /// `docs/performance.md`).
     fn par(&self) -> Par {
-        self.options.par.unwrap_or_else(|| if self.largest_supernode() >= PARALLEL_SUPERNODE { faer::get_global_parallelism() } else { Par::Seq })
+        self.options.par.unwrap_or_else(|| if self.widest_supernode >= PARALLEL_SUPERNODE { faer::get_global_parallelism() } else { Par::Seq })
     }
 
     fn factor_cholesky(&mut self, values: &[f64]) -> Result<Factorization, LinearSolverError> {
@@ -468,6 +467,13 @@ impl LinearSolver for FaerDirect {
             ),
         };
         self.pattern = Some(owned);
+        self.widest_supernode = match &symbolic {
+            Symbolic::Cholesky(c) => match c.raw() {
+                SymbolicCholeskyRaw::Supernodal(s) => s.supernode_begin().iter().zip(s.supernode_end()).map(|(b, e)| e - b).max().unwrap_or(0),
+                SymbolicCholeskyRaw::Simplicial(_) => 1,
+            },
+            Symbolic::Lu(_) => 0,
+        };
         self.symbolic = Some(symbolic);
         self.symbolic_time += start.elapsed();
         self.n_symbolic += 1;
@@ -513,7 +519,17 @@ impl LinearSolver for FaerDirect {
     }
 
     fn timings(&self) -> SolverTimings {
-        self.timings_now()
+        SolverTimings {
+            symbolic: self.symbolic_time,
+            numeric: self.numeric_time,
+            solve: Duration::from_nanos(self.solve_nanos.load(Ordering::Relaxed)),
+            n_symbolic: self.n_symbolic,
+            n_numeric: self.n_numeric,
+            n_solve: self.n_solve.load(Ordering::Relaxed) as usize,
+            n_krylov: 0,
+            n_fallback: 0,
+            n_reused: 0,
+        }
     }
 }
 
@@ -526,6 +542,7 @@ impl FaerDirect {
         self.pattern = None;
         self.diag_pos = Vec::new();
         self.l_values = Vec::new();
+        self.widest_supernode = 0;
     }
 
     /// The analysed pattern, if any.
@@ -570,19 +587,6 @@ impl FaerDirect {
         Ok(())
     }
 
-    fn timings_now(&self) -> SolverTimings {
-        SolverTimings {
-            symbolic: self.symbolic_time,
-            numeric: self.numeric_time,
-            solve: Duration::from_nanos(self.solve_nanos.load(Ordering::Relaxed)),
-            n_symbolic: self.n_symbolic,
-            n_numeric: self.n_numeric,
-            n_solve: self.n_solve.load(Ordering::Relaxed) as usize,
-            n_krylov: 0,
-            n_fallback: 0,
-            n_reused: 0,
-        }
-    }
 }
 
 #[cfg(test)]

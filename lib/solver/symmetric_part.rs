@@ -182,7 +182,7 @@ impl SymmetricPartGmres {
     /// Factor `K` (the stored values) by LU, for the reason given.
     fn factor_lu(&mut self, reason: String) -> Result<(), LinearSolverError> {
         if !self.lu_analysed {
-            let pattern = self.symmetric.pattern().ok_or(LinearSolverError::Order("factor", "analyse"))?.clone();
+            let pattern = self.symmetric.pattern().ok_or(LinearSolverError::Order("factor", "analyse"))?;
             self.lu.analyse(pattern.as_ref(), Symmetry::General)?;
             self.lu_analysed = true;
         }
@@ -263,7 +263,7 @@ impl LinearSolver for SymmetricPartGmres {
         let nnz = check_values(self.pattern(), values)?.row_idx().len();
         let start = Instant::now();
         self.lu_reason = None;
-        let method = if self.transpose.is_empty() && nnz > 0 {
+        let method = if self.general_pattern(nnz) {
             self.values_t.clear();
             self.values_t.extend_from_slice(values);
             self.factor_lu("the pattern is not structurally symmetric".into())?;
