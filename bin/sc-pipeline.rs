@@ -27,6 +27,15 @@ struct Args {
 
 fn main() -> ExitCode {
     let args = Args::parse();
+    match splinecontact::solver::ranks::participate("sc-pipeline", false) {
+        Ok(splinecontact::solver::ranks::Participation::Idle) => return ExitCode::SUCCESS,
+        Ok(splinecontact::solver::ranks::Participation::Serial(why)) => eprintln!("sc-pipeline: warning: {why}"),
+        Ok(_) => {}
+        Err(e) => {
+            eprintln!("sc-pipeline: error: {e}");
+            return ExitCode::from(splinecontact::stages::exit_code::BAD_INPUT);
+        }
+    }
     let quiet = args.quiet;
     let mut log = |line: &str| {
         if !quiet {

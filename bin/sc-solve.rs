@@ -5,6 +5,7 @@ use std::process::ExitCode;
 use clap::Parser;
 use splinecontact::format::setup::SolveSetup;
 use splinecontact::solver::log::Verbosity;
+use splinecontact::solver::ranks::{self, Participation};
 use splinecontact::stages::solve;
 
 /// Solve a finite-strain static problem on a .scmesh, or a contact problem on the
@@ -26,7 +27,14 @@ use splinecontact::stages::solve;
 ///   increments:  {count: 10, max_cutbacks: 5}
 ///   newton:      {max_iterations: 25, residual_tolerance: 1.0e-8, energy_tolerance: 1.0e-12}
 ///   linear_solver: auto   # Cholesky (nested dissection); with friction GMRES
-///                         # preconditioned by the symmetric part (LU fallback)
+///                         # preconditioned by the symmetric part (LU fallback);
+///                         # in a --features petsc build, from 300k dofs or
+///                         # under mpirun: PETSc CG/GMRES + algebraic multigrid
+///
+/// Under mpirun (a build with --features petsc) the ranks share the linear solve:
+///   mpirun -np 2 sc-solve beams.sccontact --setup solve.yaml -o beams.scres
+/// Rank 0 writes the results and the log; a build without PETSc says that it runs
+/// serially, on rank 0.
 ///
 /// eps_n is a pressure per unit penetration (times each slave node's tributary area).
 /// A body held only by contact must start touching its master or be supported, and
@@ -74,6 +82,11 @@ struct Args {
     /// increments after it are not carried over.
     #[arg(long, value_name = "K", requires = "restart")]
     restart_increment: Option<usize>,
+    /// PETSc options for `linear_solver: petsc`, after the setup's `petsc.options`
+    /// (so they win), e.g. "-ksp_monitor -pc_gamg_threshold 0.02". Needs a build with
+    /// the PETSc backend (--features petsc).
+    #[arg(long, value_name = "OPTIONS", allow_hyphen_values = true)]
+    petsc_options: Option<String>,
     /// Print nothing but warnings and errors.
     #[arg(short, long)]
     quiet: bool,
@@ -81,18 +94,41 @@ struct Args {
 
 fn main() -> ExitCode {
     let args = Args::parse();
-    let setup = match SolveSetup::read(&args.setup) {
+    let rank = match ranks::participate("sc-solve", true) {
+        Ok(Participation::Idle) => return ExitCode::SUCCESS,
+        Ok(Participation::Serial(why)) => {
+            eprintln!("sc-solve: warning: {why}");
+            0
+        }
+        Ok(Participation::Rank { rank, .. }) => rank,
+        Ok(Participation::Alone) => 0,
+        Err(e) => {
+            eprintln!("sc-solve: error: {e}");
+            return ExitCode::from(1);
+        }
+    };
+    let code = run(args, rank);
+    ranks::finish();
+    code
+}
+
+fn run(args: Args, rank: usize) -> ExitCode {
+    let mut setup = match SolveSetup::read(&args.setup) {
         Ok(s) => s,
         Err(e) => {
             eprintln!("sc-solve: error: {e}");
             return ExitCode::from(splinecontact::stages::exit_code::BAD_INPUT);
         }
     };
+    if let Some(extra) = &args.petsc_options {
+        let p = &mut setup.linear_solver.petsc.options;
+        *p = format!("{p} {extra}").trim().to_owned();
+    }
     let csv = args.csv.clone().or_else(|| solve::default_csv_path(&args.output));
     let verbosity = if args.quiet { Verbosity::Quiet } else { Verbosity::Normal };
     match solve::solve(&args.input, &setup, &args.setup.display().to_string(), &args.output, csv.as_deref(), args.restart.as_deref().map(|file| solve::Restart { file, increment: args.restart_increment }), verbosity) {
         Ok(r) => {
-            if !args.quiet {
+            if !args.quiet && rank == 0 {
                 eprintln!(
                     "solved: {} increments, {} Newton iterations, {} cutbacks, {:.2} s ({:.2} s writing results); wrote {}",
                     r.increments,
@@ -106,7 +142,9 @@ fn main() -> ExitCode {
             ExitCode::SUCCESS
         }
         Err(e) => {
-            eprintln!("sc-solve: error: {e}");
+            if rank == 0 {
+                eprintln!("sc-solve: error: {e}");
+            }
             ExitCode::from(e.exit_code())
         }
     }

@@ -363,6 +363,12 @@ impl ResultsFile {
         Self { path: path.to_path_buf(), open: None, written: 0, closed: false, bytes: 0, seconds: 0.0 }
     }
 
+    /// A results file that is never written (an MPI rank other than the first, which
+    /// computes the same increments and leaves the writing to rank 0).
+    pub fn not_written(path: &Path) -> Self {
+        Self { closed: true, ..Self::new(path) }
+    }
+
     /// Bring the file up to date with `results` (which only ever grows: more
     /// increments, then a status).
     pub fn sync(&mut self, results: &Results) -> Result<(), StageError> {

@@ -240,6 +240,43 @@ pub enum LinearSolverChoice {
     Lu,
     /// GMRES preconditioned by the factorization of the symmetric part (LU fallback).
     Gmres,
+    /// faer's direct solvers whatever the size: Cholesky for a symmetric tangent,
+    /// GMRES on the symmetric part's factorization otherwise (what `auto` does
+    /// below [`PetscSetup::auto_above_dofs`]).
+    Direct,
+    /// PETSc: CG or GMRES with algebraic multigrid (GAMG), under MPI when run by
+    /// `mpirun` (needs a build with `--features petsc`).
+    Petsc,
+}
+
+/// Dofs from which `auto` takes PETSc, in a build that has it: measured on the
+/// frictional crossed beams (`docs/performance.md`, "PETSc and algebraic
+/// multigrid").
+pub const AUTO_PETSC_ABOVE_DOFS: u64 = 300_000;
+
+/// The PETSc backend's settings (`linear_solver: {method: petsc, petsc: {...}}`).
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct PetscSetup {
+    /// PETSc options, after the defaults and before the command line's
+    /// `--petsc-options`, e.g. `"-ksp_type bcgs -pc_gamg_threshold 0.02"`.
+    pub options: String,
+    /// Relative residual of the Krylov solve, unless the inexact Newton's forcing
+    /// term is larger.
+    pub tolerance: f64,
+    /// Most Krylov iterations per solve before the MUMPS fallback.
+    pub max_iterations: u32,
+    /// Rebuild the multigrid hierarchy when a solve needs more than this factor (+5)
+    /// of the iterations right after the last rebuild (0: every Newton iteration).
+    pub reuse_growth: f64,
+    /// `auto` takes PETSc from this many dofs (unknowns, free and held), when built in.
+    pub auto_above_dofs: u64,
+}
+
+impl Default for PetscSetup {
+    fn default() -> Self {
+        Self { options: String::new(), tolerance: 1e-10, max_iterations: 500, reuse_growth: 1.5, auto_above_dofs: AUTO_PETSC_ABOVE_DOFS }
+    }
 }
 
 /// Fill-reducing ordering of the Cholesky-type factorizations.
@@ -254,7 +291,7 @@ pub enum OrderingChoice {
 }
 
 /// The linear solver: `linear_solver: auto` (a method alone) or a map with these keys.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct LinearSolverSetup {
     pub method: LinearSolverChoice,
     pub ordering: OrderingChoice,
@@ -270,6 +307,8 @@ pub struct LinearSolverSetup {
     /// its right-hand side, r being Newton's relative residual (never below
     /// `gmres_tolerance`); `false`: every solve to `gmres_tolerance`.
     pub inexact_newton: bool,
+    /// The PETSc backend (`method: petsc`, or `auto` on a large model).
+    pub petsc: PetscSetup,
 }
 
 impl Default for LinearSolverSetup {
@@ -281,6 +320,7 @@ impl Default for LinearSolverSetup {
             gmres_max_iterations: 100,
             preconditioner_reuse: 8,
             inexact_newton: true,
+            petsc: PetscSetup::default(),
         }
     }
 }
@@ -303,6 +343,8 @@ struct LinearSolverMap {
     gmres_max_iterations: Option<u32>,
     preconditioner_reuse: Option<u32>,
     inexact_newton: Option<bool>,
+    #[serde(default)]
+    petsc: PetscSetup,
 }
 
 impl<'de> Deserialize<'de> for LinearSolverSetup {
@@ -311,7 +353,7 @@ impl<'de> Deserialize<'de> for LinearSolverSetup {
         impl<'de> serde::de::Visitor<'de> for Visitor {
             type Value = LinearSolverSetup;
             fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-                f.write_str("a method (auto, cholesky, ldlt, lu, gmres) or a map with keys method, ordering, gmres_tolerance, gmres_max_iterations, preconditioner_reuse, inexact_newton")
+                f.write_str("a method (auto, direct, cholesky, ldlt, lu, gmres, petsc) or a map with keys method, ordering, gmres_tolerance, gmres_max_iterations, preconditioner_reuse, inexact_newton, petsc")
             }
             fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<Self::Value, E> {
                 let method = LinearSolverChoice::deserialize(serde::de::value::StrDeserializer::<E>::new(v))?;
@@ -324,6 +366,16 @@ impl<'de> Deserialize<'de> for LinearSolverSetup {
                 if !(tolerance > 0.0 && tolerance < 1.0) {
                     return Err(serde::de::Error::custom(format!("gmres_tolerance must lie in (0, 1), got {tolerance}")));
                 }
+                let p = &m.petsc;
+                if !(p.tolerance > 0.0 && p.tolerance < 1.0) {
+                    return Err(serde::de::Error::custom(format!("petsc.tolerance must lie in (0, 1), got {}", p.tolerance)));
+                }
+                if !(p.reuse_growth >= 0.0 && p.reuse_growth.is_finite()) {
+                    return Err(serde::de::Error::custom(format!("petsc.reuse_growth must be 0 or positive, got {}", p.reuse_growth)));
+                }
+                if p.options.contains('\0') {
+                    return Err(serde::de::Error::custom("petsc.options contains a NUL character"));
+                }
                 Ok(LinearSolverSetup {
                     method: m.method,
                     ordering: m.ordering,
@@ -331,6 +383,7 @@ impl<'de> Deserialize<'de> for LinearSolverSetup {
                     gmres_max_iterations: m.gmres_max_iterations.unwrap_or(d.gmres_max_iterations),
                     preconditioner_reuse: m.preconditioner_reuse.unwrap_or(d.preconditioner_reuse),
                     inexact_newton: m.inexact_newton.unwrap_or(d.inexact_newton),
+                    petsc: m.petsc,
                 })
             }
         }
@@ -506,17 +559,23 @@ mod tests {
         assert_eq!(s.linear_solver, LinearSolverChoice::Gmres.into());
         let s = SolveSetup::parse("s", "materials: []\nlinear_solver: {ordering: amd, gmres_tolerance: 1.0e-10}\n").unwrap();
         let d = LinearSolverSetup::default();
-        assert_eq!(s.linear_solver, LinearSolverSetup { ordering: OrderingChoice::Amd, gmres_tolerance: 1e-10, ..d });
+        assert_eq!(s.linear_solver, LinearSolverSetup { ordering: OrderingChoice::Amd, gmres_tolerance: 1e-10, ..d.clone() });
         // the default, and what a results file's setup echo reads back
         let s = SolveSetup::parse("s", "materials: []\n").unwrap();
         assert_eq!(s.linear_solver, d);
         let echo = serde_yaml::to_string(&s).unwrap();
         assert_eq!(SolveSetup::parse("echo", &echo).unwrap().linear_solver, d);
+        let s = SolveSetup::parse("s", "materials: []\nlinear_solver: {method: petsc, petsc: {options: -ksp_type bcgs, max_iterations: 50}}\n").unwrap();
+        assert_eq!(s.linear_solver.method, LinearSolverChoice::Petsc);
+        assert_eq!((s.linear_solver.petsc.options.as_str(), s.linear_solver.petsc.max_iterations), ("-ksp_type bcgs", 50));
+        assert_eq!(s.linear_solver.petsc.tolerance, PetscSetup::default().tolerance);
         for (text, expect) in [
             ("linear_solver: superlu\n", "unknown variant `superlu`"),
             ("linear_solver: {method: lu, orderng: amd}\n", "unknown field `orderng`"),
             ("linear_solver: {gmres_tolerance: 2}\n", "gmres_tolerance must lie in (0, 1)"),
-            ("linear_solver: [lu]\n", "a method (auto, cholesky, ldlt, lu, gmres) or a map"),
+            ("linear_solver: [lu]\n", "a method (auto, direct, cholesky, ldlt, lu, gmres, petsc) or a map"),
+            ("linear_solver: {method: petsc, petsc: {tolerance: 0}}\n", "petsc.tolerance must lie in (0, 1)"),
+            ("linear_solver: {method: petsc, petsc: {option: -ksp_monitor}}\n", "unknown field `option`"),
         ] {
             let e = SolveSetup::parse("s.yaml", &format!("materials: []\n{text}")).unwrap_err().to_string();
             assert!(e.contains(expect) && e.contains("line 2"), "{text}: {e}");

@@ -62,6 +62,8 @@ pub struct Outputs<'a> {
     pub csv: Option<&'a Path>,
     /// Force history (one row per converged increment): reactions and contact forces.
     pub forces_csv: Option<&'a Path>,
+    /// Whether this process writes them: false on every MPI rank but the first.
+    pub writer: bool,
 }
 
 /// The force history of the converged increments as CSV: load factor, the reaction
@@ -218,7 +220,7 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
     let first = factors_done(factors, lambda_prev);
     let mut trial = u.clone();
     let mut summary = SolveSummary { increments: 0, iterations: 0, cutbacks: 0, write_seconds: 0.0 };
-    let mut file = ResultsFile::new(out.results);
+    let mut file = if out.writer { ResultsFile::new(out.results) } else { ResultsFile::not_written(out.results) };
     let n_inc = factors.len();
     for (k, &target) in factors.iter().enumerate().skip(first) {
         let mut lambda = target;
@@ -332,6 +334,9 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
 /// two CSV histories.
 fn write(file: &mut ResultsFile, results: &Results, out: &Outputs, log: &SolveLog) -> Result<(), StageError> {
     file.sync(results)?;
+    if !out.writer {
+        return Ok(());
+    }
     if let Some(csv) = out.csv {
         write_atomic(csv, log.csv().as_bytes())?;
     }
@@ -349,7 +354,7 @@ fn stop(p: &Problem, trial: &[f64], results: &mut Results, file: &mut ResultsFil
     if let Err(e) = file.sync(results) {
         return SolveError::Write(e);
     }
-    if let Some(csv) = out.csv {
+    if let Some(csv) = out.csv.filter(|_| out.writer) {
         if let Err(e) = write_atomic(csv, log.csv().as_bytes()) {
             return SolveError::Write(e);
         }

@@ -76,6 +76,8 @@ pub enum Factorization {
     Llt,
     Ldlt,
     Lu,
+    /// No factorization: an algebraic-multigrid preconditioner (built or kept).
+    Multigrid,
 }
 
 /// What one `factor` call did.
@@ -139,6 +141,9 @@ pub enum LinearSolverError {
     DidNotConverge { iterations: usize, relative_residual: f64 },
     #[error("faer: {0}")]
     Faer(String),
+    /// An external backend's failure, with its own words (PETSc names the function).
+    #[error("{0}")]
+    Backend(String),
 }
 
 fn dof_text(dof: Option<usize>) -> String {
@@ -169,6 +174,14 @@ pub trait LinearSolver: Send {
     /// The relative residual the next solves may stop at, for an iterative
     /// backend (an inexact Newton's forcing term); a direct backend ignores it.
     fn set_forcing(&mut self, _eta: f64) {}
+    /// The current configuration: nodal reference coordinates and the full
+    /// displacement vector, before `factor` (a multigrid backend builds its
+    /// rigid-body near-null space from them); others ignore it.
+    fn set_configuration(&mut self, _reference: &[nalgebra::Vector3<f64>], _u: &[f64]) {}
+    /// Whether [`LinearSolver::set_configuration`] is read (saves the caller the call).
+    fn wants_configuration(&self) -> bool {
+        false
+    }
 }
 
 /// Widest supernode (columns) from which [`FaerDirect`] runs faer in parallel when

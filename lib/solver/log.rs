@@ -11,6 +11,9 @@ use crate::format::scres::{IncrementInfo, IterationLog};
 /// How much to print.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Verbosity {
+    /// Nothing at all (an MPI rank other than the first: rank 0 speaks for all).
+    Silent,
+    /// Warnings and errors only.
     Quiet,
     Normal,
 }
@@ -78,7 +81,7 @@ impl SolveLog {
 
     /// A message line (shown above the bar on a terminal).
     pub fn line(&self, text: &str) {
-        if self.verbosity == Verbosity::Quiet {
+        if self.verbosity != Verbosity::Normal {
             return;
         }
         self.print(text);
@@ -87,6 +90,9 @@ impl SolveLog {
     /// A warning: printed as `warning: <text>` even when quiet, since it says the
     /// answer is not what was asked for (penetration above tolerance, nodes left out).
     pub fn warning(&self, text: &str) {
+        if self.verbosity == Verbosity::Silent {
+            return;
+        }
         self.print(&format!("warning: {text}"));
     }
 

@@ -9,13 +9,17 @@
 
 pub mod amplitude;
 pub mod bench;
+pub mod block_rows;
 pub mod gmres;
 pub mod increments;
 pub mod linear;
 pub mod log;
 pub mod newton;
 pub mod ordering;
+#[cfg(feature = "petsc")]
+pub mod petsc;
 pub mod problem;
+pub mod ranks;
 pub mod restart;
 pub mod stabilization;
 pub mod symmetric_part;

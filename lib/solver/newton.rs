@@ -86,6 +86,24 @@ pub enum SetupFailure {
     Contact(#[from] PairError),
     #[error("linear_solver: {0} needs a symmetric tangent, and this problem's is not ({1}): use auto or lu")]
     NotSymmetric(&'static str, &'static str),
+    #[error("linear_solver: petsc needs sc-solve built with the PETSc backend (cargo build --release --features petsc, with PETSc and MPI installed: docs/performance.md); this build has only faer's solvers: use auto or direct")]
+    PetscNotBuilt,
+    #[error("{0} MPI ranks need the PETSc backend (linear_solver: petsc or auto); linear_solver: {1} runs on one process: start it without mpirun")]
+    DirectUnderMpi(usize, &'static str),
+}
+
+/// The PETSc backend for `problem`'s free dofs.
+#[cfg(feature = "petsc")]
+fn petsc_backend(setup: &LinearSolverSetup, problem: &Problem) -> Result<Box<dyn LinearSolver>, SetupFailure> {
+    use super::petsc::{PetscKrylov, PetscSettings};
+    let p = &setup.petsc;
+    let settings = PetscSettings { options: p.options.clone(), tolerance: p.tolerance, max_iterations: p.max_iterations as usize, reuse_growth: p.reuse_growth };
+    Ok(Box::new(PetscKrylov::new(settings, problem.dofs.global_of_free(), problem.n_nodes())?))
+}
+
+#[cfg(not(feature = "petsc"))]
+fn petsc_backend(_setup: &LinearSolverSetup, _problem: &Problem) -> Result<Box<dyn LinearSolver>, SetupFailure> {
+    Err(SetupFailure::PetscNotBuilt)
 }
 
 /// Newton workspace for one problem: the pattern, its symbolic factorization and the
@@ -151,9 +169,32 @@ impl<'p> Newton<'p> {
             let why = if problem.pressure_faces.is_empty() { "friction" } else { "follower pressure" };
             return Err(SetupFailure::NotSymmetric(if choice == LinearSolverChoice::Cholesky { "cholesky" } else { "ldlt" }, why));
         }
+        let (_, ranks) = super::ranks::rank_and_size();
+        let n_dofs = (DOFS_PER_NODE * problem.n_nodes()) as u64;
+        let petsc = match choice {
+            LinearSolverChoice::Petsc => true,
+            LinearSolverChoice::Auto => cfg!(feature = "petsc") && (ranks > 1 || n_dofs >= linear_setup.petsc.auto_above_dofs),
+            _ => false,
+        };
+        if ranks > 1 && !petsc {
+            let name = match choice {
+                LinearSolverChoice::Cholesky => "cholesky",
+                LinearSolverChoice::Ldlt => "ldlt",
+                LinearSolverChoice::Lu => "lu",
+                LinearSolverChoice::Gmres => "gmres",
+                _ => "direct",
+            };
+            return Err(SetupFailure::DirectUnderMpi(ranks, name));
+        }
         let (symmetry, strategy) = match choice {
-            LinearSolverChoice::Auto if problem.symmetric() => (Symmetry::Symmetric, SymmetricStrategy::LltThenLdlt),
-            LinearSolverChoice::Auto | LinearSolverChoice::Lu | LinearSolverChoice::Gmres => (Symmetry::General, SymmetricStrategy::LltThenLdlt),
+            LinearSolverChoice::Auto | LinearSolverChoice::Direct | LinearSolverChoice::Petsc if problem.symmetric() => {
+                (Symmetry::Symmetric, SymmetricStrategy::LltThenLdlt)
+            }
+            LinearSolverChoice::Auto
+            | LinearSolverChoice::Direct
+            | LinearSolverChoice::Petsc
+            | LinearSolverChoice::Lu
+            | LinearSolverChoice::Gmres => (Symmetry::General, SymmetricStrategy::LltThenLdlt),
             LinearSolverChoice::Cholesky => (Symmetry::Symmetric, SymmetricStrategy::Llt),
             LinearSolverChoice::Ldlt => (Symmetry::Symmetric, SymmetricStrategy::Ldlt),
         };
@@ -166,11 +207,15 @@ impl<'p> Newton<'p> {
             ..Default::default()
         };
         let gmres = GmresSettings { tolerance: linear_setup.gmres_tolerance, max_iterations: linear_setup.gmres_max_iterations as usize, ..Default::default() };
-        let mut linear: Box<dyn LinearSolver> = match (symmetry, choice) {
-            (Symmetry::General, LinearSolverChoice::Auto | LinearSolverChoice::Gmres) => {
-                Box::new(SymmetricPartGmres::with_reuse(gmres, direct, linear_setup.preconditioner_reuse as usize))
+        let mut linear: Box<dyn LinearSolver> = if petsc {
+            petsc_backend(&linear_setup, problem)?
+        } else {
+            match (symmetry, choice) {
+                (Symmetry::General, LinearSolverChoice::Auto | LinearSolverChoice::Direct | LinearSolverChoice::Gmres) => {
+                    Box::new(SymmetricPartGmres::with_reuse(gmres, direct, linear_setup.preconditioner_reuse as usize))
+                }
+                _ => Box::new(FaerDirect::new(direct)),
             }
-            _ => Box::new(FaerDirect::new(direct)),
         };
         linear.analyse(pattern.symbolic(), symmetry)?;
         let n = DOFS_PER_NODE * problem.n_nodes();
@@ -530,6 +575,9 @@ impl<'p> Newton<'p> {
                 }
             }
             let t = Instant::now();
+            if self.linear.wants_configuration() {
+                self.linear.set_configuration(&self.problem.X, u);
+            }
             self.linear.factor(self.assembly.values()).map_err(|error| IncrementFailure::Linear { iteration, error })?;
             row.seconds_factor = t.elapsed().as_secs_f64();
             if self.inexact_newton {
@@ -543,7 +591,7 @@ impl<'p> Newton<'p> {
             self.linear.solve_in_place(&mut self.r_free).map_err(|error| IncrementFailure::Linear { iteration, error })?;
             row.seconds_solve = t.elapsed().as_secs_f64();
             if let Some(why) = self.linear.last_solve().fallback {
-                self.linear_notes.push(format!("iteration {iteration}: {why}: solved by LU instead"));
+                self.linear_notes.push(format!("iteration {iteration}: {why}"));
             }
             if iteration == 0 {
                 energy0 = self.r_free.iter().zip(&self.rhs).map(|(du, r)| du * r).sum::<f64>().abs();

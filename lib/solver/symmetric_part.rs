@@ -304,7 +304,7 @@ impl LinearSolver for SymmetricPartGmres {
         let start = Instant::now();
         self.n_solve += 1;
         if let Some(reason) = &self.lu_reason {
-            self.last = SolveReport { krylov_iterations: 0, fallback: Some(reason.clone()) };
+            self.last = SolveReport { krylov_iterations: 0, fallback: Some(format!("{reason}: solved by LU instead")) };
             let r = self.lu.solve_in_place(rhs);
             self.solve_time += start.elapsed();
             return r;
@@ -345,7 +345,7 @@ impl LinearSolver for SymmetricPartGmres {
                 self.numeric_time += t.elapsed();
                 factored?;
                 rhs.copy_from_slice(&self.rhs);
-                self.last = SolveReport { krylov_iterations: iterations, fallback: Some(why) };
+                self.last = SolveReport { krylov_iterations: iterations, fallback: Some(format!("{why}: solved by LU instead")) };
                 self.lu.solve_in_place(rhs)
             }
         };

@@ -72,8 +72,12 @@ pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, 
             )));
         }
     }
-    let mut newton = Newton::new(&problem, setup.newton.clone(), setup.linear_solver)?;
-    let mut log = SolveLog::new(verbosity, factors.len());
+    let mut newton = Newton::new(&problem, setup.newton.clone(), setup.linear_solver.clone())?;
+    let (rank, ranks) = crate::solver::ranks::rank_and_size();
+    let mut log = SolveLog::new(if rank > 0 { Verbosity::Silent } else { verbosity }, factors.len());
+    if ranks > 1 {
+        log.line(&format!("MPI: {ranks} ranks; each owns a contiguous range of nodes of the linear system; rank 0 writes the results and this log"));
+    }
     for (c, def) in newton.contact.iter().zip(&problem.contact) {
         let s = &c.settings;
         log.line(&format!(
@@ -139,7 +143,9 @@ pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, 
         results.increments = point.increments;
     }
     let forces = output.with_extension("forces.csv");
-    let outputs = Outputs { results: output, csv, forces_csv: Some(&forces) };
+    // under mpirun every rank computes the same increments; the first writes them
+    let writer = rank == 0;
+    let outputs = Outputs { results: output, csv, forces_csv: Some(&forces), writer };
     let summary = increments::solve(&mut newton, &factors, setup.increments.max_cutbacks, &mut results, &outputs, &mut log);
     if !newton.contact.is_empty() {
         log.line(&format!("contact: the sparsity pattern was rebuilt {} times as contact elements changed", newton.pattern_rebuilds));
@@ -156,7 +162,7 @@ pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, 
         t.solve.as_secs_f64(),
         if t.n_krylov > 0 || t.n_fallback > 0 {
             format!(
-                ", {} GMRES iterations ({:.1} per solve), {} preconditioners kept from the iteration before, {} solved by the LU fallback",
+                ", {} Krylov iterations ({:.1} per solve), {} preconditioners kept from the iteration before, {} solved by the direct fallback",
                 t.n_krylov,
                 t.n_krylov as f64 / t.n_solve.max(1) as f64,
                 t.n_reused,
