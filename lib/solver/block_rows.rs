@@ -36,6 +36,8 @@ pub struct BlockRows {
     constrained_diag: Vec<u32>,
     /// Destination of each free dof's diagonal (the scale of the constrained rows).
     free_diag: Vec<u32>,
+    /// Global dof of each free dof.
+    global_of_free_diag: Vec<u32>,
 }
 
 /// A pattern this layout cannot address.
@@ -108,7 +110,7 @@ impl BlockRows {
             is_free[g as usize] = true;
         }
         let constrained_diag = (0..3 * n_nodes).filter(|&g| !is_free[g]).map(|g| at(g, g)).collect();
-        Ok(Self { ptr, cols, dest, constrained_diag, free_diag })
+        Ok(Self { ptr, cols, dest, constrained_diag, free_diag, global_of_free_diag: global_of_free.to_vec() })
     }
 
     /// Number of node blocks stored.
@@ -123,28 +125,41 @@ impl BlockRows {
 
     /// Fills `block_values` (length `9·n_blocks`) with the full system: `K_ff`'s
     /// values (CSC order), zeros where only a constrained dof meets, and
-    /// `d = mean |diag K_ff|` on the constrained diagonal. Returns the number of free
-    /// diagonal entries that are not positive (an indefinite tangent, which a
-    /// multigrid preconditioner cannot handle).
-    pub fn scatter(&self, values: &[f64], block_values: &mut [f64]) -> usize {
+    /// `d = mean |diag K_ff|` on the constrained diagonal. Collects into
+    /// `non_positive` the free diagonal entries that are not positive, as (global
+    /// dof, position in `block_values`, value): an indefinite tangent, which a
+    /// multigrid preconditioner cannot be built from as it stands.
+    pub fn scatter(&self, values: &[f64], block_values: &mut [f64], non_positive: &mut Vec<(usize, usize, f64)>) {
         block_values.iter_mut().for_each(|v| *v = 0.0);
         for (&d, &v) in self.dest.iter().zip(values) {
             block_values[d as usize] = v;
         }
+        non_positive.clear();
         let mut sum = 0.0;
-        let mut non_positive = 0;
-        for &d in &self.free_diag {
+        for (f, &d) in self.free_diag.iter().enumerate() {
             let v = block_values[d as usize];
             sum += v.abs();
             if !(v > 0.0) {
-                non_positive += 1;
+                non_positive.push((self.global_of_free_diag[f] as usize, d as usize, v));
             }
         }
-        let scale = if self.free_diag.is_empty() || sum == 0.0 { 1.0 } else { sum / self.free_diag.len() as f64 };
+        let scale = self.diagonal_scale(sum);
         for &d in &self.constrained_diag {
             block_values[d as usize] = scale;
         }
-        non_positive
+    }
+
+    fn diagonal_scale(&self, sum: f64) -> f64 {
+        if self.free_diag.is_empty() || sum == 0.0 {
+            1.0
+        } else {
+            sum / self.free_diag.len() as f64
+        }
+    }
+
+    /// The scale `d` of the constrained diagonal in `block_values` (after `scatter`).
+    pub fn constrained_scale(&self, block_values: &[f64]) -> f64 {
+        self.diagonal_scale(self.free_diag.iter().map(|&d| block_values[d as usize].abs()).sum())
     }
 
     /// Block columns of block row `i`, and the offset of its values.
@@ -172,7 +187,9 @@ mod tests {
         assert_eq!(b.ptr, vec![0, 2, 4]);
         assert_eq!(b.cols, vec![0, 1, 0, 1]);
         let mut bv = vec![f64::NAN; 9 * b.n_blocks()];
-        assert_eq!(b.scatter(&values, &mut bv), 0);
+        let mut bad = Vec::new();
+        b.scatter(&values, &mut bv, &mut bad);
+        assert!(bad.is_empty());
         // dense 6×6 from the block rows
         let mut full = [[0.0; 6]; 6];
         for i in 0..2 {
@@ -205,6 +222,9 @@ mod tests {
         let pattern = SymbolicSparseColMat::new_checked(3, 3, vec![0, 1, 2, 3], None, vec![0, 1, 2]);
         let b = BlockRows::new(pattern.as_ref(), &[0, 1, 2], 1).unwrap();
         let mut bv = vec![0.0; 9];
-        assert_eq!(b.scatter(&[1.0, -2.0, 0.0], &mut bv), 2);
+        let mut bad = Vec::new();
+        b.scatter(&[1.0, -2.0, 0.0], &mut bv, &mut bad);
+        assert_eq!(bad, vec![(1, 4, -2.0), (2, 8, 0.0)]);
+        assert_eq!(b.constrained_scale(&bv), 1.0);
     }
 }

@@ -116,6 +116,8 @@ pub struct SolveReport {
     pub krylov_iterations: usize,
     /// Why an iterative backend solved this system by its direct fallback.
     pub fallback: Option<String>,
+    /// Anything else the log should say about this solve.
+    pub note: Option<String>,
 }
 
 /// Linear-solver failures.

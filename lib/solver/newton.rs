@@ -590,7 +590,8 @@ impl<'p> Newton<'p> {
             self.r_free.iter_mut().zip(&self.rhs).for_each(|(du, r)| *du = -r);
             self.linear.solve_in_place(&mut self.r_free).map_err(|error| IncrementFailure::Linear { iteration, error })?;
             row.seconds_solve = t.elapsed().as_secs_f64();
-            if let Some(why) = self.linear.last_solve().fallback {
+            let report = self.linear.last_solve();
+            if let Some(why) = report.fallback.or(report.note) {
                 self.linear_notes.push(format!("iteration {iteration}: {why}"));
             }
             if iteration == 0 {

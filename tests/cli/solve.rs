@@ -245,3 +245,40 @@ fn restart_from_an_earlier_increment() {
     let o = run("sc-solve", &["c.scmesh", "--setup", "setup.yaml", "-o", "x.scres", "--restart-increment", "2"], dir.path());
     assert_fails(&o, 2, &["--restart"], &dir.path().join("x.scres"));
 }
+
+/// A build without the PETSc backend says how to get it when a setup asks for it,
+/// before anything is written.
+#[cfg(not(feature = "petsc"))]
+#[test]
+fn petsc_in_a_build_without_it_says_how_to_build_it() {
+    solve_fails(&format!("{GOOD}linear_solver: petsc\n"), &["linear_solver: petsc", "--features petsc"]);
+}
+
+/// Started by mpirun with two ranks (the launcher's environment, as Open MPI sets
+/// it), a build without PETSc says on rank 0 that it runs serially and solves there;
+/// rank 1 stops at once and writes nothing.
+#[cfg(not(feature = "petsc"))]
+#[test]
+fn under_mpirun_a_build_without_petsc_runs_serially_on_rank_0() {
+    let dir = tempdir();
+    imported_cantilever(dir.path());
+    write_setup(dir.path(), GOOD);
+    let exe = env!("CARGO_BIN_EXE_sc-solve");
+    let launch = |rank: &str, out: &str| {
+        std::process::Command::new(exe)
+            .args(["c.scmesh", "--setup", "setup.yaml", "-o", out, "-q"])
+            .current_dir(dir.path())
+            .env("OMPI_COMM_WORLD_RANK", rank)
+            .env("OMPI_COMM_WORLD_SIZE", "2")
+            .output()
+            .unwrap()
+    };
+    let o = launch("0", "r0.scres");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(err.contains("2 ranks") && err.contains("runs serially on rank 0") && err.contains("--features petsc"), "{err}");
+    assert!(dir.path().join("r0.scres").exists());
+    let o = launch("1", "r1.scres");
+    assert!(o.status.success() && stderr(&o).is_empty(), "{}", stderr(&o));
+    assert!(!dir.path().join("r1.scres").exists());
+}

@@ -8,3 +8,5 @@ mod ironing;
 mod shallow_ironing;
 mod sliding;
 mod ccx_compare;
+#[cfg(feature = "petsc")]
+mod petsc;

@@ -25,10 +25,19 @@
 //! hierarchy. `-pc_gamg_reuse_interpolation` keeps GAMG's aggregates across
 //! rebuilds on one pattern.
 //!
-//! **Fallback.** An indefinite tangent (a non-positive free diagonal: the Newton
-//! overshoot at first contact) or a Krylov solve that fails go to a direct solve by
-//! MUMPS through PETSc (Cholesky for a symmetric tangent, LU otherwise; prefix
-//! `fallback_` for its options), and the log says so.
+//! **An indefinite tangent.** The Newton iterate after first contact overshoots
+//! (the body goes through its master), and the tangent there has non-positive
+//! diagonal entries, from which smoothed aggregation builds no usable hierarchy.
+//! Neither a hierarchy built from a repaired copy (diagonal `max(|a_ii|, d)`) for
+//! GMRES on the true tangent, nor GMRES on the repaired tangent itself (a modified
+//! Newton step) converged in 500 iterations on the crossed beams at 109k dofs, so
+//! such a tangent goes straight to the direct fallback, and the next iteration
+//! builds a fresh hierarchy.
+//!
+//! **Fallback.** An indefinite tangent, or a Krylov solve that fails, goes to a direct solve by MUMPS
+//! through PETSc (Cholesky for a symmetric tangent, LU otherwise; prefix
+//! `fallback_` for its options; its factors are freed after the solve), and the log
+//! says so.
 //!
 //! **Options.** Defaults are set first, then the setup's `petsc_options`, then the
 //! command line's `--petsc-options` (later ones win): any PETSc option, e.g.
@@ -116,10 +125,9 @@ pub struct PetscKrylov {
     /// Iterations of the first solve after the last rebuild.
     base_iterations: Option<usize>,
     last_iterations: usize,
-    /// The last factored matrix had a non-positive free diagonal.
-    indefinite: bool,
-    /// The fallback's factorization matches the current matrix.
-    fallback_current: bool,
+    /// The last factored matrix's non-positive free diagonal entries (global dof,
+    /// position in `block_values`, value).
+    indefinite: Vec<(usize, usize, f64)>,
     eta: f64,
     report: SolveReport,
     timings: SolverTimings,
@@ -153,8 +161,7 @@ impl PetscKrylov {
             rebuild: true,
             base_iterations: None,
             last_iterations: 0,
-            indefinite: false,
-            fallback_current: false,
+            indefinite: Vec::new(),
             eta: 0.0,
             report: SolveReport::default(),
             timings: SolverTimings::default(),
@@ -280,13 +287,14 @@ impl PetscKrylov {
                 check("PCFactorSetMatSolverType", PCFactorSetMatSolverType(pc, cstr("mumps").as_ptr()))?;
                 check("KSPSetFromOptions", KSPSetFromOptions(self.fallback))?;
             }
-            if !self.fallback_current {
-                check("KSPSetUp", KSPSetUp(self.fallback))?;
-                self.fallback_current = true;
-            }
+            check("KSPSetUp", KSPSetUp(self.fallback))?;
             check("KSPSolve", KSPSolve(self.fallback, self.b, self.x))?;
             let mut reason: c_int = 0;
             check("KSPGetConvergedReason", KSPGetConvergedReason(self.fallback, &mut reason))?;
+            // its factors go: at the sizes this backend is for they are the largest
+            // thing in memory, and the next fallback has another matrix anyway
+            KSPDestroy(&mut self.fallback);
+            self.fallback = Handle::NULL;
             if reason < 0 {
                 return Err(LinearSolverError::Backend(format!("the MUMPS fallback failed (KSPConvergedReason {reason})")));
             }
@@ -319,9 +327,10 @@ impl LinearSolver for PetscKrylov {
         self.rows = Some(rows);
         self.symmetry = symmetry;
         self.create_matrix()?;
+        // the Krylov solver now, so that a bad option is reported before the first solve
+        self.create_ksp()?;
         self.rebuild = true;
         self.base_iterations = None;
-        self.fallback_current = false;
         self.timings.symbolic += start.elapsed();
         self.timings.n_symbolic += 1;
         Ok(())
@@ -330,11 +339,13 @@ impl LinearSolver for PetscKrylov {
     fn factor(&mut self, values: &[f64]) -> Result<FactorInfo, LinearSolverError> {
         let start = Instant::now();
         let _guard = LOCK.lock().unwrap_or_else(|p| p.into_inner());
-        let rows = self.rows.as_ref().ok_or(LinearSolverError::Order("factor", "analyse"))?;
+        let Some(rows) = self.rows.as_ref() else {
+            return Err(LinearSolverError::Order("factor", "analyse"));
+        };
         if let Some(index) = values.iter().position(|v| !v.is_finite()) {
             return Err(LinearSolverError::NonFinite { index });
         }
-        self.indefinite = rows.scatter(values, &mut self.block_values) > 0;
+        rows.scatter(values, &mut self.block_values, &mut self.indefinite);
         let (first, last) = self.owned;
         unsafe {
             for i in first..last {
@@ -350,11 +361,6 @@ impl LinearSolver for PetscKrylov {
             let symmetric = if self.symmetry == Symmetry::Symmetric { sc_PETSC_TRUE } else { sc_PETSC_FALSE };
             check("MatSetOption", MatSetOption(self.mat, sc_MAT_SYMMETRIC, symmetric))?;
         }
-        self.fallback_current = false;
-        if self.ksp.is_null() {
-            self.create_ksp()?;
-            self.rebuild = true;
-        }
         // keep the hierarchy while the iterations stay near those of its first solve
         if let Some(base) = self.base_iterations {
             let limit = (self.settings.reuse_growth * base as f64) as usize + 5;
@@ -362,13 +368,13 @@ impl LinearSolver for PetscKrylov {
                 self.rebuild = true;
             }
         }
-        let reuse = !self.rebuild;
+        let reuse = !self.rebuild && self.indefinite.is_empty();
         unsafe {
             check("KSPSetReusePreconditioner", KSPSetReusePreconditioner(self.ksp, if reuse { sc_PETSC_TRUE } else { sc_PETSC_FALSE }))?;
         }
         if reuse {
             self.timings.n_reused += 1;
-        } else if !self.indefinite {
+        } else if self.indefinite.is_empty() {
             self.attach_near_null_space()?;
             unsafe { check("KSPSetUp", KSPSetUp(self.ksp))? };
             self.rebuild = false;
@@ -405,8 +411,11 @@ impl LinearSolver for PetscKrylov {
         }
         self.report = SolveReport::default();
         let mut iterations = 0;
-        if self.indefinite {
-            self.report.fallback = Some("the tangent has a non-positive diagonal (indefinite, as after a Newton overshoot), which multigrid cannot precondition: solved by MUMPS (direct) instead".into());
+        if !self.indefinite.is_empty() {
+            self.report.fallback = Some(format!(
+                "the tangent has {} non-positive diagonal entries (indefinite, as after a Newton overshoot), from which multigrid builds no usable hierarchy: solved by MUMPS (direct) instead",
+                self.indefinite.len()
+            ));
             self.solve_direct()?;
             self.rebuild = true;
         } else {
@@ -530,24 +539,30 @@ mod tests {
     }
 
     /// A non-positive diagonal (the indefinite tangent after a Newton overshoot)
-    /// skips multigrid: MUMPS solves it, and the report says so.
+    /// skips multigrid: MUMPS solves it, the report says so, its factors are freed,
+    /// and the next factor builds a hierarchy.
     #[test]
     fn an_indefinite_tangent_goes_to_the_direct_fallback() {
         let (cube, mut s) = cube_solver(3, PetscSettings::default());
         let p = &cube.pattern;
         let mut values = cube.assembly.values().to_vec();
-        // flip the sign of one free diagonal entry (a symmetric change)
-        let j = 0;
-        let k = (p.col_ptr()[j]..p.col_ptr()[j + 1]).find(|&k| p.row_idx()[k] == j).unwrap();
-        values[k] = -values[k];
+        for j in [0, 10] {
+            let k = (p.col_ptr()[j]..p.col_ptr()[j + 1]).find(|&k| p.row_idx()[k] == j).unwrap();
+            values[k] = -values[k];
+        }
         s.analyse(p.symbolic(), Symmetry::General).unwrap();
         s.factor(&values).unwrap();
         let mut x = cube.rhs.clone();
         s.solve_in_place(&mut x).unwrap();
         let why = s.last_solve().fallback.expect("fallback reported");
-        assert!(why.contains("non-positive diagonal") && why.contains("MUMPS"), "{why}");
+        assert!(why.contains("2 non-positive diagonal entries") && why.contains("MUMPS"), "{why}");
         let r = relative_residual(p.col_ptr(), p.row_idx(), &values, &x, &cube.rhs);
         assert!(r <= 1e-10, "MUMPS residual {r:e}");
+        assert!(s.fallback.is_null(), "the MUMPS factors are freed");
+        s.factor(cube.assembly.values()).unwrap();
+        let mut y = cube.rhs.clone();
+        s.solve_in_place(&mut y).unwrap();
+        assert!(s.last_solve().fallback.is_none() && s.last_solve().krylov_iterations > 0);
         assert_eq!(s.timings().n_fallback, 1);
     }
 
