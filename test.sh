@@ -4,7 +4,11 @@
 # it first on PATH (tests call `gmsh` and python's meshio), installs CalculiX (Debian's
 # calculix-ccx, for the side-by-side test of docs/scripts/ccx_compare.py) when it is
 # missing and we are root, then runs the Rust unit and integration tests in release
-# mode.
+# mode. Then the PETSc backend: installs PETSc and Open MPI (Debian's
+# libpetsc-real-dev, openmpi-bin) when they are missing and we are root, builds with
+# --features petsc (in target/petsc, beside the default build) and runs its tests,
+# the two-rank mpirun one included. Without PETSc and without root it says that it
+# skips them, unless SC_REQUIRE_PETSC=1 (CI), which makes that an error.
 set -euo pipefail
 cd "$(dirname "$0")"
 if ! .venv/bin/python -c "import meshio, gmsh, yaml" >/dev/null 2>&1; then
@@ -25,3 +29,21 @@ fi
 export PATH="$PWD/.venv/bin:$PATH"
 export SC_PYTHON="$PWD/.venv/bin/python"
 cargo test --release --locked "$@"
+
+have_petsc() { pkg-config --exists PETSc 2>/dev/null && command -v mpirun >/dev/null 2>&1; }
+if ! have_petsc; then
+    if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
+        echo "test.sh: installing PETSc and Open MPI (apt-get) for the petsc feature's tests" >&2
+        apt-get update -qq >/dev/null
+        DEBIAN_FRONTEND=noninteractive apt-get install -y -qq libpetsc-real-dev libopenblas0-serial libopenmpi-dev openmpi-bin pkg-config >/dev/null
+    elif [ "${SC_REQUIRE_PETSC:-0}" = 1 ]; then
+        echo "test.sh: PETSc and MPI are missing (sudo apt-get install libpetsc-real-dev libopenmpi-dev openmpi-bin pkg-config)" >&2
+        exit 1
+    else
+        echo "test.sh: SKIPPING the PETSc backend's tests: PETSc and MPI are missing and we are not root (sudo apt-get install libpetsc-real-dev libopenmpi-dev openmpi-bin pkg-config)" >&2
+        exit 0
+    fi
+fi
+# Open MPI refuses to run as root unless told (CI runs as root)
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+CARGO_TARGET_DIR="$PWD/target/petsc" cargo test --release --locked --features petsc petsc

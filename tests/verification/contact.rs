@@ -179,7 +179,7 @@ fn assembled_contact_tangent_matches_finite_differences() {
         }
         let setup = SolveSetup::parse("s", &yaml).unwrap();
         let problem = Problem::with_contact(&model.mesh, &model.pairs, &setup, "s").unwrap();
-        let mut newton = Newton::new(&problem, setup.newton.clone(), setup.linear_solver).unwrap();
+        let mut newton = Newton::new(&problem, setup.newton.clone(), setup.linear_solver.clone()).unwrap();
         // the slave block shrunk by 10 % in x and y about the centre (so its edge nodes
         // project into the master's edge spans, not beyond), sheared, moved 0.02 down
         let n = mesh.nodes.len();

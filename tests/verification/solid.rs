@@ -162,7 +162,7 @@ fn rigid_rotation_90_degrees() {
                 [(d, c * x[0] - s * x[1] - x[0]), (d + 1, s * x[0] + c * x[1] - x[1]), (d + 2, 0.0)].map(|(dof, value)| Prescribed { dof, value, amplitude: 0 })
             })
             .collect();
-        let mut newton = Newton::new(&problem, setup.newton.clone(), setup.linear_solver).unwrap();
+        let mut newton = Newton::new(&problem, setup.newton.clone(), setup.linear_solver.clone()).unwrap();
         newton.solve_increment(1.0, &mut u, &mut |_| {}).unwrap();
     }
     // Every node rotated by 90°: u = (R − I) X.
