@@ -25,8 +25,10 @@ Our programs come from target/release (or $SC_BIN_DIR).
 Options: --threads T (2), --out DIR (pipelines/out/compare/<model>), --contact
 node|surface (ccx contact type, node by default), --no-ccx (ours only, e.g. past
 ccx's memory), --linear-solver M (ours: auto, lu, gmres, cholesky...), --ordering O
-(nested_dissection, amd), --json, --plot PNG (log-log time against dofs; needs
-matplotlib in the venv).
+(nested_dissection, amd), --mpi-ranks P (ours under `mpirun -np P`, each rank
+with T/P threads; needs a build with --features petsc; the peak RSS is then the
+largest rank's), --json, --plot PNG (log-log time against dofs; needs matplotlib
+in the venv).
 Exit code 0 when both finished and agree within the tolerances below at every
 level, 1 otherwise (the table says where).
 """
@@ -157,6 +159,19 @@ def newton_iterations(csv_path):
     return n
 
 
+def phase_seconds(csv_path):
+    """Seconds per phase over every Newton iteration of the convergence CSV."""
+    out = dict(contact_s=0.0, assembly_s=0.0, factor_s=0.0, solve_s=0.0)
+    if not csv_path.exists():
+        return {}
+    import csv
+    with open(csv_path) as f:
+        for r in csv.DictReader(f):
+            for k, col in (("contact_s", "seconds_contact"), ("assembly_s", "seconds_assembly"), ("factor_s", "seconds_factor"), ("solve_s", "seconds_solve")):
+                out[k] += float(r[col] or 0.0)
+    return {k: round(v, 2) for k, v in out.items()}
+
+
 def rel(a, b):
     return abs(a - b) / max(abs(a), 1e-300)
 
@@ -170,21 +185,29 @@ def run_level(model, spec, n, a, out_root):
     subprocess.run([gmsh_exe(), str(ROOT / spec["geo"]), "-3", "-format", "msh41", "-bin", *params, "-o", str(msh)],
                    check=True, capture_output=True)
     pipeline, setup_path, stages = level_pipeline(spec, msh, level_dir, name, a.linear_solver_setup)
-    row = dict(model=model, level=n, params=spec["params"](n), threads=a.threads)
+    row = dict(model=model, level=n, params=spec["params"](n), threads=a.threads, mpi_ranks=a.mpi_ranks)
     # import + tag (not timed)
     prep = [st for st in stages if next(iter(st)) in ("import", "tag")]
     prep_path = level_dir / (name + ".prep.yaml")
     prep_path.write_text(yaml.safe_dump(dict(version=1, name=name + "-prep", stages=prep), sort_keys=False))
     subprocess.run([our_exe("sc-pipeline"), "-q", str(prep_path)], check=True)
     # ours, timed: sc-solve as a whole process
-    env = dict(os.environ, RAYON_NUM_THREADS=str(a.threads))
-    rc, wall, rss = run_measured([our_exe("sc-solve"), name + ".sccontact", "--setup", setup_path.name, "-o", name + ".scres"],
-                                 level_dir, env, level_dir / (name + ".solve.log"))
+    env = dict(os.environ, RAYON_NUM_THREADS=str(max(1, a.threads // a.mpi_ranks)))
+    cmd = [our_exe("sc-solve"), name + ".sccontact", "--setup", setup_path.name, "-o", name + ".scres"]
+    if a.mpi_ranks > 1:
+        # Open MPI refuses root unless told
+        env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+        cmd = ["mpirun", "-np", str(a.mpi_ranks), "--oversubscribe", *cmd]
+    rc, wall, rss = run_measured(cmd, level_dir, env, level_dir / (name + ".solve.log"))
     log = (level_dir / (name + ".solve.log")).read_text()
     m = re.search(r"(\d+) free dofs", log)
     row["dofs"] = int(m.group(1)) if m else None
     m = re.search(r"linear solver (\S+): .*", log)
     row["ours"] = dict(ok=rc == 0, wall_s=round(wall, 2), peak_rss_mb=round(rss, 1), linear=m.group(0) if m else None)
+    row["ours"].update(phase_seconds(level_dir / (name + ".convergence.csv")))
+    m = re.search(r"(\d+) Krylov iterations \(([\d.]+) per solve\)", log)
+    if m:
+        row["ours"]["krylov_per_solve"] = float(m.group(2))
     if rc == 0:
         subprocess.run([our_exe("sc-export"), "-q", name + ".scres", "-o", name + ".pvd"], cwd=level_dir, check=True)
         row["ours"]["newton_iterations"] = newton_iterations(level_dir / (name + ".convergence.csv"))
@@ -258,6 +281,7 @@ def main(argv=None):
     ap.add_argument("--no-ccx", action="store_true")
     ap.add_argument("--linear-solver", default=None)
     ap.add_argument("--ordering", default=None)
+    ap.add_argument("--mpi-ranks", type=int, default=1)
     ap.add_argument("--ccx", default=shutil.which("ccx") or "/usr/bin/ccx")
     ap.add_argument("--json", action="store_true")
     ap.add_argument("--plot", default=None)

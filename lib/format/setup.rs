@@ -271,11 +271,14 @@ pub struct PetscSetup {
     pub reuse_growth: f64,
     /// `auto` takes PETSc from this many dofs (unknowns, free and held), when built in.
     pub auto_above_dofs: u64,
+    /// Largest system (dofs) the MUMPS fallback factors; above it a solve that needs
+    /// it fails and the load step is cut back.
+    pub direct_fallback_max_dofs: u64,
 }
 
 impl Default for PetscSetup {
     fn default() -> Self {
-        Self { options: String::new(), tolerance: 1e-10, max_iterations: 500, reuse_growth: 1.5, auto_above_dofs: AUTO_PETSC_ABOVE_DOFS }
+        Self { options: String::new(), tolerance: 1e-10, max_iterations: 500, reuse_growth: 1.5, auto_above_dofs: AUTO_PETSC_ABOVE_DOFS, direct_fallback_max_dofs: 300_000 }
     }
 }
 

@@ -16,6 +16,7 @@ use std::time::Instant;
 use nalgebra::{DMatrix, DVector, Vector3};
 
 use super::problem::Problem;
+use super::ranks;
 use super::stabilization::Stabilization;
 use crate::assembly::{Assembly, AssemblyError, ElementFailure, NodeGroups, Pattern, PatternError, DOFS_PER_NODE};
 use crate::contact::element::ContactElementError;
@@ -97,7 +98,13 @@ pub enum SetupFailure {
 fn petsc_backend(setup: &LinearSolverSetup, problem: &Problem) -> Result<Box<dyn LinearSolver>, SetupFailure> {
     use super::petsc::{PetscKrylov, PetscSettings};
     let p = &setup.petsc;
-    let settings = PetscSettings { options: p.options.clone(), tolerance: p.tolerance, max_iterations: p.max_iterations as usize, reuse_growth: p.reuse_growth };
+    let settings = PetscSettings {
+        options: p.options.clone(),
+        tolerance: p.tolerance,
+        max_iterations: p.max_iterations as usize,
+        reuse_growth: p.reuse_growth,
+        direct_fallback_max_dofs: p.direct_fallback_max_dofs as usize,
+    };
     Ok(Box::new(PetscKrylov::new(settings, problem.dofs.global_of_free(), problem.n_nodes())?))
 }
 
@@ -123,6 +130,8 @@ pub struct Newton<'p> {
     pub contact: Vec<PairSolver>,
     /// Owner of every group of `pattern`.
     owners: Vec<GroupOwner>,
+    /// Under MPI with several ranks: the share of the assembly this rank does.
+    partition: Option<Partition>,
     /// The contact search's groups, compared with the pattern's every iteration
     /// (storage reused).
     group_scratch: NodeGroups,
@@ -158,12 +167,19 @@ impl<'p> Newton<'p> {
         for def in &problem.contact {
             contact.push(PairSolver::new(def, &problem.X)?);
         }
+        let partition = Partition::of(problem, &linear_setup);
         let (mut owners, mut groups) = (Vec::new(), NodeGroups::new());
         contact_groups(problem, &mut contact, &vec![0.0; DOFS_PER_NODE * problem.n_nodes()], &mut groups, &mut owners)?;
+        if let Some(part) = &partition {
+            part.keep_local_groups(&mut groups, &mut owners);
+        }
         for pair in &mut contact {
             pair.init_history();
         }
-        let pattern = Pattern::build(problem.dofs.clone(), &problem.hexes, groups)?;
+        let pattern = match &partition {
+            Some(part) => Pattern::build(problem.dofs.clone(), &part.hexes, groups)?,
+            None => Pattern::build(problem.dofs.clone(), &problem.hexes, groups)?,
+        };
         let assembly = Assembly::new(&pattern)?;
         if !problem.symmetric() && matches!(choice, LinearSolverChoice::Cholesky | LinearSolverChoice::Ldlt) {
             let why = if problem.pressure_faces.is_empty() { "friction" } else { "follower pressure" };
@@ -233,6 +249,7 @@ impl<'p> Newton<'p> {
             f_ext: vec![0.0; n],
             contact,
             owners,
+            partition,
             group_scratch: NodeGroups::new(),
             pattern_rebuilds: 0,
             symmetry,
@@ -254,7 +271,16 @@ impl<'p> Newton<'p> {
         let fail = |message: String| IncrementFailure::ContactSetup { iteration, message };
         let mut groups = std::mem::take(&mut self.group_scratch);
         contact_groups(self.problem, &mut self.contact, u, &mut groups, &mut self.owners).map_err(|e| fail(e.to_string()))?;
-        if &groups == self.pattern.groups() && self.assembly.fits(&self.pattern) {
+        if let Some(part) = &self.partition {
+            part.keep_local_groups(&mut groups, &mut self.owners);
+        }
+        let mut changed = [f64::from(u8::from(&groups != self.pattern.groups() || !self.assembly.fits(&self.pattern)))];
+        if self.partition.is_some() {
+            // the analysis of a new pattern is collective: every rank does it when
+            // one rank's groups changed (its rows' entries did)
+            ranks::max_over_ranks(&mut changed).map_err(|e| fail(format!("MPI: {e}")))?;
+        }
+        if changed[0] == 0.0 {
             self.group_scratch = groups;
         } else {
             self.pattern = self.pattern.with_groups(groups).map_err(|e| fail(e.to_string()))?;
@@ -274,10 +300,8 @@ impl<'p> Newton<'p> {
     /// row_idx, values)`, K_ff in compressed sparse columns over the free dofs.
     pub fn residual_tangent_at(&mut self, u: &[f64], lambda: f64) -> Result<ResidualTangent, IncrementFailure> {
         self.contact_search(u, 0)?;
-        self.assemble(u, lambda).map_err(|f| match f {
-            AssemblyFailure::Hex(element, error) => IncrementFailure::Element { iteration: 0, element, error },
-            AssemblyFailure::Contact(pair, s, error) => IncrementFailure::Contact { iteration: 0, pair: self.contact[pair].name.clone(), node_tag: self.contact[pair].slaves[s] as u64, error },
-        })?;
+        let node_tags = &self.problem.node_tags;
+        self.assemble(u, lambda).map_err(|f| f.into_increment_failure(0, &self.contact, node_tags))?;
         Ok((self.residual.clone(), self.pattern.col_ptr().to_vec(), self.pattern.row_idx().to_vec(), self.assembly.values().to_vec()))
     }
 
@@ -362,7 +386,9 @@ impl<'p> Newton<'p> {
     /// [`Self::contact_search`] at the same `u`).
     fn assemble(&mut self, u: &[f64], lambda: f64) -> Result<(), AssemblyFailure> {
         let p = self.problem;
+        let hex_ids = self.partition.as_ref().map(|part| &part.hex_ids[..]);
         let hex = |e: usize, r: &mut _, k: &mut _| {
+            let e = hex_ids.map_or(e, |ids| ids[e] as usize);
             let (X, ue) = p.gather(e, u);
             hex8_residual_tangent(&X, &ue, &p.materials[p.hex_material[e] as usize], p.formulation, r, k).map_err(LocalFailure::Hex)
         };
@@ -389,20 +415,44 @@ impl<'p> Newton<'p> {
             Ok(())
         };
         let res = self.assembly.assemble_with_groups(&self.pattern, hex, group);
-        let full = match res {
-            Ok((_, r)) => r,
+        let (full, failure) = match res {
+            Ok((_, r)) => (Some(r), None),
             Err(ElementFailure::Hex { element, error }) | Err(ElementFailure::Group { group: element, error }) => {
-                return Err(match error {
-                    LocalFailure::Hex(error) => AssemblyFailure::Hex(element, error),
+                let f = match error {
+                    LocalFailure::Hex(error) => AssemblyFailure::Hex(hex_ids.map_or(element, |ids| ids[element] as usize), error),
                     LocalFailure::Contact(error) => match owners[element] {
                         GroupOwner::Contact(pair, s) => AssemblyFailure::Contact(pair, s, error),
                         GroupOwner::Pressure(_) => unreachable!("pressure faces do not return contact errors"),
                     },
-                })
+                };
+                (None, Some(f))
             }
         };
-        for ((out, r), f) in self.residual.iter_mut().zip(full).zip(&self.f_ext) {
-            *out = r - f;
+        if let Some(part) = &self.partition {
+            // every rank takes the same branch: the worst failure of any rank decides
+            let local = failure.as_ref().map_or(0.0, AssemblyFailure::severity);
+            let mut worst = [local];
+            ranks::max_over_ranks(&mut worst).map_err(AssemblyFailure::Mpi)?;
+            if worst[0] > local {
+                return Err(AssemblyFailure::OtherRank(worst[0] as u8));
+            }
+            if let Some(f) = failure {
+                return Err(f);
+            }
+            // this rank's residual is complete on the dofs of its nodes only: those,
+            // summed over the ranks, give every rank the whole residual
+            let (a, b) = (DOFS_PER_NODE * part.first, DOFS_PER_NODE * part.last);
+            for (d, ((out, r), f)) in self.residual.iter_mut().zip(full.unwrap_or(&[])).zip(&self.f_ext).enumerate() {
+                *out = if d >= a && d < b { r - f } else { 0.0 };
+            }
+            ranks::sum_over_ranks(&mut self.residual).map_err(AssemblyFailure::Mpi)?;
+        } else {
+            if let Some(f) = failure {
+                return Err(f);
+            }
+            for ((out, r), f) in self.residual.iter_mut().zip(full.unwrap_or(&[])).zip(&self.f_ext) {
+                *out = r - f;
+            }
         }
         if let Some(s) = &self.stabilization {
             s.add_residual(u, &mut self.residual);
@@ -467,18 +517,12 @@ impl<'p> Newton<'p> {
                     }
                     // Step control: the correction inverted an element; go back half of
                     // it and try again before giving the increment up.
-                    Err(AssemblyFailure::Hex(..)) if iteration > 0 && halvings < self.settings.max_step_halvings => {
+                    Err(AssemblyFailure::Hex(..) | AssemblyFailure::OtherRank(1)) if iteration > 0 && halvings < self.settings.max_step_halvings => {
                         self.step_halvings += 1;
                     }
                     Err(f) => {
                         self.release_contact();
-                        return Err(match f {
-                            AssemblyFailure::Hex(element, error) => IncrementFailure::Element { iteration, element, error },
-                            AssemblyFailure::Contact(pair, s, error) => {
-                                let c = &self.contact[pair];
-                                IncrementFailure::Contact { iteration, pair: c.name.clone(), node_tag: p.node_tags.get(c.slaves[s] as usize).copied().unwrap_or(c.slaves[s] as u64), error }
-                            }
-                        });
+                        return Err(f.into_increment_failure(iteration, &self.contact, &p.node_tags));
                     }
                 }
                 // back half of the correction: u ← u − ½Δu (Δu, kept in r_free, halves)
@@ -631,6 +675,79 @@ enum AssemblyFailure {
     Hex(usize, ElementError),
     /// (pair, slave index, error)
     Contact(usize, usize, ContactElementError),
+    /// Another MPI rank's assembly failed ([`AssemblyFailure::severity`] of its failure).
+    OtherRank(u8),
+    /// An MPI reduction failed.
+    Mpi(String),
+}
+
+impl AssemblyFailure {
+    /// What every rank must do about a failure: 1 an inverted element (Newton halves
+    /// the step), 2 anything else (the increment fails).
+    fn severity(&self) -> f64 {
+        match self {
+            Self::Hex(..) | Self::OtherRank(1) => 1.0,
+            _ => 2.0,
+        }
+    }
+
+    /// The increment's failure, at `iteration` (`contact` names the pairs).
+    fn into_increment_failure(self, iteration: u32, contact: &[PairSolver], node_tags: &[u64]) -> IncrementFailure {
+        match self {
+            Self::Hex(element, error) => IncrementFailure::Element { iteration, element, error },
+            Self::Contact(pair, s, error) => {
+                let c = &contact[pair];
+                IncrementFailure::Contact { iteration, pair: c.name.clone(), node_tag: node_tags.get(c.slaves[s] as usize).copied().unwrap_or(c.slaves[s] as u64), error }
+            }
+            Self::OtherRank(1) => IncrementFailure::ContactSetup { iteration, message: "an element assembled by another MPI rank inverted or failed".into() },
+            Self::OtherRank(_) => IncrementFailure::ContactSetup { iteration, message: "the assembly failed on another MPI rank (its log says why)".into() },
+            Self::Mpi(message) => IncrementFailure::ContactSetup { iteration, message: format!("MPI: {message}") },
+        }
+    }
+}
+
+/// The share of the assembly one of several MPI ranks does: the hexahedra that touch
+/// its nodes (`first..last`, the rows of the linear system it owns,
+/// [`ranks::owned_nodes`]) and the node groups (contact elements, pressure faces)
+/// that do. Every entry of its rows gets all its contributions there; the hexahedra
+/// at a rank boundary are computed by both neighbours.
+struct Partition {
+    first: usize,
+    last: usize,
+    /// Global index of each local hexahedron.
+    hex_ids: Vec<u32>,
+    /// Their connectivity (the local pattern's elements).
+    hexes: Vec<[u32; 8]>,
+}
+
+impl Partition {
+    /// This rank's share, when the linear solver is distributed over several ranks.
+    fn of(problem: &Problem, setup: &LinearSolverSetup) -> Option<Self> {
+        let (_, size) = ranks::rank_and_size();
+        if size < 2 || !matches!(setup.method, LinearSolverChoice::Petsc | LinearSolverChoice::Auto) {
+            return None;
+        }
+        let (first, last) = ranks::owned_nodes(problem.n_nodes());
+        let mine = |n: &u32| (*n as usize) >= first && (*n as usize) < last;
+        let hex_ids: Vec<u32> = (0..problem.hexes.len() as u32).filter(|&e| problem.hexes[e as usize].iter().any(mine)).collect();
+        let hexes = hex_ids.iter().map(|&e| problem.hexes[e as usize]).collect();
+        Some(Self { first, last, hex_ids, hexes })
+    }
+
+    /// Keeps the groups that touch this rank's nodes (and their owners).
+    fn keep_local_groups(&self, groups: &mut NodeGroups, owners: &mut Vec<GroupOwner>) {
+        let mine = |n: &u32| (*n as usize) >= self.first && (*n as usize) < self.last;
+        let mut kept = NodeGroups::new();
+        let mut kept_owners = Vec::with_capacity(owners.len());
+        for (g, nodes) in groups.iter().enumerate() {
+            if nodes.iter().any(mine) {
+                kept.push(nodes);
+                kept_owners.push(owners[g]);
+            }
+        }
+        *groups = kept;
+        *owners = kept_owners;
+    }
 }
 
 /// Contact search of every pair at `u` and the node groups of the pattern into

@@ -113,3 +113,29 @@ pub fn finish() {
     #[cfg(feature = "petsc")]
     super::petsc::finalize();
 }
+
+/// Sums `x` over all ranks, in place (nothing to do on one).
+pub fn sum_over_ranks(x: &mut [f64]) -> Result<(), String> {
+    #[cfg(feature = "petsc")]
+    {
+        super::petsc::runtime::sum_over_ranks(x).map_err(|e| e.to_string())
+    }
+    #[cfg(not(feature = "petsc"))]
+    {
+        let _ = x;
+        Ok(())
+    }
+}
+
+/// The largest of `x` over all ranks, in place (nothing to do on one).
+pub fn max_over_ranks(x: &mut [f64]) -> Result<(), String> {
+    #[cfg(feature = "petsc")]
+    {
+        super::petsc::runtime::max_over_ranks(x).map_err(|e| e.to_string())
+    }
+    #[cfg(not(feature = "petsc"))]
+    {
+        let _ = x;
+        Ok(())
+    }
+}

@@ -7,7 +7,7 @@
 
 #![allow(non_upper_case_globals, non_camel_case_types)]
 
-use std::ffi::{c_char, c_int, c_long, c_void};
+use std::ffi::{c_char, c_int, c_void};
 
 pub type PetscErrorCode = c_int;
 pub type PetscInt = i32;
@@ -57,7 +57,6 @@ extern "C" {
     pub fn sc_ksp_create(k: *mut Ksp) -> PetscErrorCode;
     pub fn sc_allreduce_sum_f64(x: *mut f64, n: c_int) -> c_int;
     pub fn sc_allreduce_max_f64(x: *mut f64, n: c_int) -> c_int;
-    pub fn sc_broadcast_bytes(x: *mut c_void, n: c_long, root: c_int) -> c_int;
 
     // PETSc
     pub fn PetscFinalize() -> PetscErrorCode;

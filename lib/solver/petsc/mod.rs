@@ -34,10 +34,14 @@
 //! such a tangent goes straight to the direct fallback, and the next iteration
 //! builds a fresh hierarchy.
 //!
-//! **Fallback.** An indefinite tangent, or a Krylov solve that fails, goes to a direct solve by MUMPS
+//! **Fallback.** An indefinite tangent, or a Krylov solve that fails, goes to a
+//! direct solve by MUMPS
 //! through PETSc (Cholesky for a symmetric tangent, LU otherwise; prefix
 //! `fallback_` for its options; its factors are freed after the solve), and the log
-//! says so.
+//! says so, on systems up to `direct_fallback_max_dofs` (300k: MUMPS's LU of the
+//! crossed beams at 1M dofs needs more than 19 GB). Above it the solve fails and
+//! Newton cuts the load step back, which at first contact is what helps: the
+//! smaller step overshoots less.
 //!
 //! **Options.** Defaults are set first, then the setup's `petsc_options`, then the
 //! command line's `--petsc-options` (later ones win): any PETSc option, e.g.
@@ -78,11 +82,15 @@ pub struct PetscSettings {
     /// iterations of the first solve after the last rebuild; `0`: rebuild every
     /// Newton iteration.
     pub reuse_growth: f64,
+    /// Largest system (dofs, held ones included) the MUMPS fallback may factor;
+    /// above it a solve that needs the fallback fails, and Newton cuts the load step
+    /// back (a smaller step overshoots less at first contact).
+    pub direct_fallback_max_dofs: usize,
 }
 
 impl Default for PetscSettings {
     fn default() -> Self {
-        Self { options: String::new(), tolerance: 1e-10, max_iterations: 500, reuse_growth: 1.5 }
+        Self { options: String::new(), tolerance: 1e-10, max_iterations: 500, reuse_growth: 1.5, direct_fallback_max_dofs: 300_000 }
     }
 }
 
@@ -128,6 +136,8 @@ pub struct PetscKrylov {
     /// The last factored matrix's non-positive free diagonal entries (global dof,
     /// position in `block_values`, value).
     indefinite: Vec<(usize, usize, f64)>,
+    /// Their number over all ranks.
+    indefinite_total: usize,
     eta: f64,
     report: SolveReport,
     timings: SolverTimings,
@@ -162,6 +172,7 @@ impl PetscKrylov {
             base_iterations: None,
             last_iterations: 0,
             indefinite: Vec::new(),
+            indefinite_total: 0,
             eta: 0.0,
             report: SolveReport::default(),
             timings: SolverTimings::default(),
@@ -272,7 +283,14 @@ impl PetscKrylov {
     }
 
     /// Direct solve of `b` into `x` by MUMPS through PETSc.
-    fn solve_direct(&mut self) -> Result<(), LinearSolverError> {
+    fn solve_direct(&mut self, why: &str) -> Result<(), LinearSolverError> {
+        let n = 3 * self.n_nodes;
+        if n > self.settings.direct_fallback_max_dofs {
+            return Err(LinearSolverError::Backend(format!(
+                "{why}, and {n} dofs are beyond the MUMPS fallback's limit (petsc.direct_fallback_max_dofs = {})",
+                self.settings.direct_fallback_max_dofs
+            )));
+        }
         unsafe {
             if self.fallback.is_null() {
                 let symmetric = self.symmetry == Symmetry::Symmetric;
@@ -342,11 +360,24 @@ impl LinearSolver for PetscKrylov {
         let Some(rows) = self.rows.as_ref() else {
             return Err(LinearSolverError::Order("factor", "analyse"));
         };
-        if let Some(index) = values.iter().position(|v| !v.is_finite()) {
-            return Err(LinearSolverError::NonFinite { index });
+        // a non-finite value stops every rank (the calls that follow are collective)
+        let bad = values.iter().position(|v| !v.is_finite());
+        let mut any_bad = [f64::from(u8::from(bad.is_some()))];
+        runtime::max_over_ranks(&mut any_bad).map_err(|e| LinearSolverError::Backend(e.to_string()))?;
+        if any_bad[0] > 0.0 {
+            return Err(match bad {
+                Some(index) => LinearSolverError::NonFinite { index },
+                None => LinearSolverError::Backend("another MPI rank's tangent has a non-finite value".into()),
+            });
         }
         rows.scatter(values, &mut self.block_values, &mut self.indefinite);
         let (first, last) = self.owned;
+        // only this rank's rows are complete (and inserted); whether the tangent is
+        // indefinite is decided by all ranks together, as what follows is collective
+        self.indefinite.retain(|&(g, _, _)| g >= 3 * first && g < 3 * last);
+        let mut count = [self.indefinite.len() as f64];
+        runtime::sum_over_ranks(&mut count).map_err(|e| LinearSolverError::Backend(e.to_string()))?;
+        self.indefinite_total = count[0] as usize;
         unsafe {
             for i in first..last {
                 let (cols, offset) = rows.row(i);
@@ -368,13 +399,13 @@ impl LinearSolver for PetscKrylov {
                 self.rebuild = true;
             }
         }
-        let reuse = !self.rebuild && self.indefinite.is_empty();
+        let reuse = !self.rebuild && self.indefinite_total == 0;
         unsafe {
             check("KSPSetReusePreconditioner", KSPSetReusePreconditioner(self.ksp, if reuse { sc_PETSC_TRUE } else { sc_PETSC_FALSE }))?;
         }
         if reuse {
             self.timings.n_reused += 1;
-        } else if self.indefinite.is_empty() {
+        } else if self.indefinite_total == 0 {
             self.attach_near_null_space()?;
             unsafe { check("KSPSetUp", KSPSetUp(self.ksp))? };
             self.rebuild = false;
@@ -411,12 +442,14 @@ impl LinearSolver for PetscKrylov {
         }
         self.report = SolveReport::default();
         let mut iterations = 0;
-        if !self.indefinite.is_empty() {
-            self.report.fallback = Some(format!(
-                "the tangent has {} non-positive diagonal entries (indefinite, as after a Newton overshoot), from which multigrid builds no usable hierarchy: solved by MUMPS (direct) instead",
-                self.indefinite.len()
-            ));
-            self.solve_direct()?;
+        if self.indefinite_total > 0 {
+            let why = format!(
+                "the tangent has {} non-positive diagonal entries (indefinite, as after a Newton overshoot), from which multigrid builds no usable hierarchy",
+                self.indefinite_total
+            );
+            self.rebuild = true;
+            self.solve_direct(&why)?;
+            self.report.fallback = Some(format!("{why}: solved by MUMPS (direct) instead"));
             self.rebuild = true;
         } else {
             let rtol = self.eta.max(self.settings.tolerance);
@@ -435,12 +468,10 @@ impl LinearSolver for PetscKrylov {
                 self.base_iterations = Some(iterations);
             }
             if reason < 0 {
-                self.report.fallback = Some(format!(
-                    "the Krylov solve stopped after {iterations} iterations ({}): solved by MUMPS (direct) instead",
-                    runtime::converged_reason(reason)
-                ));
-                self.solve_direct()?;
+                let why = format!("the Krylov solve stopped after {iterations} iterations ({})", runtime::converged_reason(reason));
                 self.rebuild = true;
+                self.solve_direct(&why)?;
+                self.report.fallback = Some(format!("{why}: solved by MUMPS (direct) instead"));
             }
         }
         self.report.krylov_iterations = iterations;
@@ -564,6 +595,11 @@ mod tests {
         s.solve_in_place(&mut y).unwrap();
         assert!(s.last_solve().fallback.is_none() && s.last_solve().krylov_iterations > 0);
         assert_eq!(s.timings().n_fallback, 1);
+        // above the fallback's size limit the solve fails (Newton then cuts back)
+        s.settings.direct_fallback_max_dofs = 10;
+        s.factor(&values).unwrap();
+        let e = s.solve_in_place(&mut cube.rhs.clone()).unwrap_err().to_string();
+        assert!(e.contains("non-positive diagonal") && e.contains("direct_fallback_max_dofs = 10"), "{e}");
     }
 
     /// A Krylov solve that cannot finish in its budget falls back, and says why.

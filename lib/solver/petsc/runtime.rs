@@ -4,7 +4,7 @@
 //! runs under `mpirun` should start it before it reads anything, so every rank
 //! agrees on its rank from the start, and call [`finalize`] before it exits.
 
-use std::ffi::{c_int, c_void, CStr};
+use std::ffi::{c_int, CStr};
 use std::sync::OnceLock;
 
 use super::ffi::*;
@@ -77,18 +77,6 @@ pub fn max_over_ranks(x: &mut [f64]) -> Result<(), PetscError> {
     let code = unsafe { sc_allreduce_max_f64(x.as_mut_ptr(), x.len() as c_int) };
     if code != 0 {
         return Err(PetscError(format!("MPI_Allreduce failed with code {code}")));
-    }
-    Ok(())
-}
-
-/// Overwrites `bytes` on every rank with rank `root`'s.
-pub fn broadcast(bytes: &mut [u8], root: usize) -> Result<(), PetscError> {
-    if rank_and_size().1 == 1 {
-        return Ok(());
-    }
-    let code = unsafe { sc_broadcast_bytes(bytes.as_mut_ptr() as *mut c_void, bytes.len() as std::ffi::c_long, root as c_int) };
-    if code != 0 {
-        return Err(PetscError(format!("MPI_Bcast failed with code {code}")));
     }
     Ok(())
 }

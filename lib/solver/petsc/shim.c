@@ -82,17 +82,3 @@ int sc_allreduce_max_f64(double *x, int n)
 {
   return MPI_Allreduce(MPI_IN_PLACE, x, n, MPI_DOUBLE, MPI_MAX, PETSC_COMM_WORLD);
 }
-
-int sc_broadcast_bytes(void *x, long n, int root)
-{
-  /* MPI counts are int: send a long message in pieces */
-  char *p = (char *)x;
-  while (n > 0) {
-    int chunk = n > (1L << 30) ? (1 << 30) : (int)n;
-    int e = MPI_Bcast(p, chunk, MPI_BYTE, root, PETSC_COMM_WORLD);
-    if (e) return e;
-    p += chunk;
-    n -= chunk;
-  }
-  return 0;
-}
