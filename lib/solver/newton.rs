@@ -278,7 +278,7 @@ impl<'p> Newton<'p> {
         if self.partition.is_some() {
             // the analysis of a new pattern is collective: every rank does it when
             // one rank's groups changed (its rows' entries did)
-            ranks::max_over_ranks(&mut changed).map_err(|e| fail(format!("MPI: {e}")))?;
+            ranks::reduce_over_ranks(&mut changed, ranks::Reduction::Max).map_err(|e| fail(format!("MPI: {e}")))?;
         }
         if changed[0] == 0.0 {
             self.group_scratch = groups;
@@ -432,7 +432,7 @@ impl<'p> Newton<'p> {
             // every rank takes the same branch: the worst failure of any rank decides
             let local = failure.as_ref().map_or(0.0, AssemblyFailure::severity);
             let mut worst = [local];
-            ranks::max_over_ranks(&mut worst).map_err(AssemblyFailure::Mpi)?;
+            ranks::reduce_over_ranks(&mut worst, ranks::Reduction::Max).map_err(AssemblyFailure::Mpi)?;
             if worst[0] > local {
                 return Err(AssemblyFailure::OtherRank(worst[0] as u8));
             }
@@ -445,7 +445,7 @@ impl<'p> Newton<'p> {
             for (d, ((out, r), f)) in self.residual.iter_mut().zip(full.unwrap_or(&[])).zip(&self.f_ext).enumerate() {
                 *out = if d >= a && d < b { r - f } else { 0.0 };
             }
-            ranks::sum_over_ranks(&mut self.residual).map_err(AssemblyFailure::Mpi)?;
+            ranks::reduce_over_ranks(&mut self.residual, ranks::Reduction::Sum).map_err(AssemblyFailure::Mpi)?;
         } else {
             if let Some(f) = failure {
                 return Err(f);

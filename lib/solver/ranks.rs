@@ -114,28 +114,22 @@ pub fn finish() {
     super::petsc::finalize();
 }
 
-/// Sums `x` over all ranks, in place (nothing to do on one).
-pub fn sum_over_ranks(x: &mut [f64]) -> Result<(), String> {
-    #[cfg(feature = "petsc")]
-    {
-        super::petsc::runtime::sum_over_ranks(x).map_err(|e| e.to_string())
-    }
-    #[cfg(not(feature = "petsc"))]
-    {
-        let _ = x;
-        Ok(())
-    }
+/// How [`reduce_over_ranks`] combines the ranks' values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Reduction {
+    Sum,
+    Max,
 }
 
-/// The largest of `x` over all ranks, in place (nothing to do on one).
-pub fn max_over_ranks(x: &mut [f64]) -> Result<(), String> {
+/// Combines `x` over all ranks, in place (nothing to do on one).
+pub fn reduce_over_ranks(x: &mut [f64], op: Reduction) -> Result<(), String> {
     #[cfg(feature = "petsc")]
     {
-        super::petsc::runtime::max_over_ranks(x).map_err(|e| e.to_string())
+        super::petsc::runtime::reduce_over_ranks(x, op).map_err(|e| e.to_string())
     }
     #[cfg(not(feature = "petsc"))]
     {
-        let _ = x;
+        let _ = (x, op);
         Ok(())
     }
 }

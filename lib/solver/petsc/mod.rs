@@ -60,7 +60,7 @@ use nalgebra::Vector3;
 use self::ffi::*;
 use super::block_rows::BlockRows;
 use super::linear::{FactorInfo, Factorization, LinearSolver, LinearSolverError, SolveReport, SolverTimings, Symmetry};
-use super::ranks::owned_nodes;
+use super::ranks::{owned_nodes, Reduction};
 pub use runtime::{finalize, initialize, PetscError};
 
 /// Every PETSc call of the process goes through this lock: PETSc's global state
@@ -363,7 +363,7 @@ impl LinearSolver for PetscKrylov {
         // a non-finite value stops every rank (the calls that follow are collective)
         let bad = values.iter().position(|v| !v.is_finite());
         let mut any_bad = [f64::from(u8::from(bad.is_some()))];
-        runtime::max_over_ranks(&mut any_bad).map_err(|e| LinearSolverError::Backend(e.to_string()))?;
+        runtime::reduce_over_ranks(&mut any_bad, Reduction::Max).map_err(|e| LinearSolverError::Backend(e.to_string()))?;
         if any_bad[0] > 0.0 {
             return Err(match bad {
                 Some(index) => LinearSolverError::NonFinite { index },
@@ -376,7 +376,7 @@ impl LinearSolver for PetscKrylov {
         // indefinite is decided by all ranks together, as what follows is collective
         self.indefinite.retain(|&(g, _, _)| g >= 3 * first && g < 3 * last);
         let mut count = [self.indefinite.len() as f64];
-        runtime::sum_over_ranks(&mut count).map_err(|e| LinearSolverError::Backend(e.to_string()))?;
+        runtime::reduce_over_ranks(&mut count, Reduction::Sum).map_err(|e| LinearSolverError::Backend(e.to_string()))?;
         self.indefinite_total = count[0] as usize;
         unsafe {
             for i in first..last {
