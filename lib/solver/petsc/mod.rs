@@ -4,15 +4,20 @@
 //! program runs under `mpirun` (cargo feature `petsc`).
 //!
 //! **Why.** A direct factorization's fill grows like N^{4/3} on 3D meshes: the
-//! crossed beams at 1M dofs would need about 40 GB. AMG needs O(N) memory and
+//! crossed beams at 1M dofs would need about 25 GB. AMG needs O(N) memory and
 //! nearly size-independent iteration counts (`docs/performance.md`).
 //!
 //! **The matrix.** AIJ with block size 3 over the full `3n` system
 //! ([`super::block_rows`]: constrained rows are `d·I`), each rank owning a
 //! contiguous range of nodes ([`super::ranks::owned_nodes`]) and inserting only
-//! those block rows: the tangent is assembled on every rank, so nothing is shipped.
-//! GAMG rejects block-AIJ (BAIJ) in PETSc 3.18; AIJ with block size 3 still gets
-//! node aggregation and inode kernels.
+//! those block rows. Under MPI each rank's Newton assembles every element that
+//! touches its nodes (`newton::Partition`), so its rows are complete and nothing is
+//! shipped at assembly. GAMG rejects block-AIJ (BAIJ) in PETSc 3.18; AIJ with block
+//! size 3 still gets node aggregation and inode kernels.
+//!
+//! **Collective calls.** Every PETSc call here is collective under MPI, so every
+//! branch before one is decided by all ranks together (the indefinite check and the
+//! non-finite check reduce over ranks); a branch taken by one rank alone deadlocks.
 //!
 //! **Near-null space.** The six rigid-body modes at the current nodal coordinates
 //! (`MatNullSpaceCreateRigidBody`), rebuilt with the hierarchy. Without them GAMG
@@ -21,7 +26,7 @@
 //! **Reuse.** The hierarchy of one Newton iteration serves the next ones
 //! (`KSPSetReusePreconditioner`) while a solve needs at most `reuse_growth` times
 //! the iterations it needed right after it was built (and a few more); then it is
-//! rebuilt. A new pattern (the contact groups changed) rebuilds the matrix and the
+//! rebuilt. (The iteration counts are the same on every rank.) A new pattern (the contact groups changed) rebuilds the matrix and the
 //! hierarchy. `-pc_gamg_reuse_interpolation` keeps GAMG's aggregates across
 //! rebuilds on one pattern.
 //!
@@ -43,7 +48,7 @@
 //! Newton cuts the load step back, which at first contact is what helps: the
 //! smaller step overshoots less.
 //!
-//! **Options.** Defaults are set first, then the setup's `petsc_options`, then the
+//! **Options.** Defaults are set first, then the setup's `petsc.options`, then the
 //! command line's `--petsc-options` (later ones win): any PETSc option, e.g.
 //! `-ksp_type bcgs`, `-pc_type hypre`, `-ksp_monitor`.
 
@@ -240,7 +245,7 @@ impl PetscKrylov {
             check("PetscOptionsInsertString", PetscOptionsInsertString(std::ptr::null_mut(), cstr(DEFAULT_OPTIONS).as_ptr()))?;
             if !self.settings.options.trim().is_empty() {
                 let user = CString::new(self.settings.options.as_str())
-                    .map_err(|_| LinearSolverError::Backend("petsc_options contains a NUL character".into()))?;
+                    .map_err(|_| LinearSolverError::Backend("petsc.options contains a NUL character".into()))?;
                 check("PetscOptionsInsertString", PetscOptionsInsertString(std::ptr::null_mut(), user.as_ptr()))?;
             }
             check("KSPCreate", sc_ksp_create(&mut self.ksp))?;
