@@ -244,11 +244,16 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
                 Ok(conv) => {
                     let t = Instant::now();
                     u.copy_from_slice(&trial);
-                    let stress = match gauss_stresses(p, &u) {
-                        Ok(s) => s,
-                        Err((element, error)) => {
-                            let failure = IncrementFailure::Element { iteration: 0, element, error };
-                            return Err(stop(p, &trial, results, &mut file, out, log, k + 1, lambda, lambda_prev, cutbacks_this, failure));
+                    // stresses are output only: an MPI rank that does not write skips them
+                    let stress = if !out.writer {
+                        Vec::new()
+                    } else {
+                        match gauss_stresses(p, &u) {
+                            Ok(s) => s,
+                            Err((element, error)) => {
+                                let failure = IncrementFailure::Element { iteration: 0, element, error };
+                                return Err(stop(p, &trial, results, &mut file, out, log, k + 1, lambda, lambda_prev, cutbacks_this, failure));
+                            }
                         }
                     };
                     summary.iterations += conv.iterations.len().saturating_sub(1);
@@ -291,6 +296,13 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
                         friction,
                     });
                     write(&mut file, results, out, log)?;
+                    if !out.writer {
+                        // nor does it keep the history's arrays (0.2 GB an increment at
+                        // 1M dofs); the count and the summaries stay
+                        if let Some(old) = results.increments.len().checked_sub(2).and_then(|i| results.increments.get_mut(i)) {
+                            (old.u, old.contact, old.friction) = (Vec::new(), Vec::new(), Vec::new());
+                        }
+                    }
                     summary.increments += 1;
                     log.line(&format!(
                         "increment {}/{n_inc} converged at load factor {lambda:.6} in {} iterations{}",
