@@ -1,4 +1,4 @@
-//! The results stage file, `.scres` (format `scres`, version 2.0): the mesh, the
+//! The results stage file, `.scres` (format `scres`, version 2.1): the mesh, the
 //! setup that produced it, and the full state of every converged increment
 //! (displacements, Cauchy stress at the Gauss points, reactions, convergence
 //! history), so that a run can be inspected, exported or restarted from it.
@@ -26,7 +26,7 @@ pub const FORMAT: &str = "scres";
 /// 2.0: one segment per increment, appended (1.x: one META listing every
 /// increment, the whole file rewritten after each).
 pub const MAJOR: u32 = 2;
-pub const MINOR: u32 = 0;
+pub const MINOR: u32 = 1;
 
 /// One Newton iteration, as logged.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
@@ -49,6 +49,10 @@ pub struct IterationLog {
     /// Uzawa update this Newton solve follows (0 = first solve of the increment).
     #[serde(default)]
     pub augmentation: u32,
+    /// Krylov iterations of this iteration's linear solve (0 for a direct solve, and
+    /// for the converged row, which solves nothing).
+    #[serde(default)]
+    pub krylov_iterations: u32,
 }
 
 /// Reaction force summed over a constrained node set.

@@ -36,6 +36,8 @@ pub struct IterationEvent {
     pub contact_active: u32,
     /// Uzawa update the Newton solve follows.
     pub augmentation: u32,
+    /// Krylov iterations of the linear solve.
+    pub krylov_iterations: u32,
 }
 
 impl IterationEvent {
@@ -56,6 +58,7 @@ impl IterationEvent {
             seconds_contact: row.seconds_contact,
             contact_active: row.contact_active,
             augmentation: row.augmentation,
+            krylov_iterations: row.krylov_iterations,
         }
     }
 }
@@ -68,7 +71,7 @@ pub struct SolveLog {
 }
 
 impl SolveLog {
-    pub const CSV_HEADER: &'static str = "increment,load_factor,attempt,augmentation,iteration,residual,energy,contact_active,seconds_contact,seconds_assembly,seconds_factor,seconds_solve\n";
+    pub const CSV_HEADER: &'static str = "increment,load_factor,attempt,augmentation,iteration,residual,energy,contact_active,seconds_contact,seconds_assembly,seconds_factor,seconds_solve,krylov_iterations\n";
 
     pub fn new(verbosity: Verbosity, n_increments: usize) -> Self {
         let bar = (verbosity == Verbosity::Normal && std::io::stderr().is_terminal()).then(|| {
@@ -151,7 +154,7 @@ impl SolveLog {
 
     fn push_csv(&mut self, e: &IterationEvent) {
         self.csv.push_str(&format!(
-            "{},{:e},{},{},{},{:e},{:e},{},{:.6},{:.6},{:.6},{:.6}\n",
+            "{},{:e},{},{},{},{:e},{:e},{},{:.6},{:.6},{:.6},{:.6},{}\n",
             e.increment,
             e.load_factor,
             e.attempt,
@@ -163,7 +166,8 @@ impl SolveLog {
             e.seconds_contact,
             e.seconds_assembly,
             e.seconds_factor,
-            e.seconds_solve
+            e.seconds_solve,
+            e.krylov_iterations
         ));
     }
 

@@ -572,6 +572,7 @@ impl<'p> Newton<'p> {
                 seconds_contact,
                 contact_active: self.n_contact_pressed() as u32,
                 augmentation: self.contact.iter().map(|c| c.augmentations).max().unwrap_or(0),
+                krylov_iterations: 0,
             };
             if converged || r_norm == 0.0 {
                 on_iteration(&row);
@@ -635,6 +636,7 @@ impl<'p> Newton<'p> {
             self.linear.solve_in_place(&mut self.r_free).map_err(|error| IncrementFailure::Linear { iteration, error })?;
             row.seconds_solve = t.elapsed().as_secs_f64();
             let report = self.linear.last_solve();
+            row.krylov_iterations = report.krylov_iterations as u32;
             if let Some(why) = report.fallback.or(report.note) {
                 self.linear_notes.push(format!("iteration {iteration}: {why}"));
             }

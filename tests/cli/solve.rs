@@ -97,7 +97,7 @@ fn cantilever_pipeline_results_open_in_meshio() {
     let uz: f64 = out.split("\"max_abs_u\": [").nth(1).unwrap().split(']').next().unwrap().split(", ").nth(2).unwrap().parse().unwrap();
     assert!((uz - 3.2044).abs() < 3.2044e-4, "tip deflection {uz}");
     let csv = std::fs::read_to_string(dir.path().join("pipelines/out/cantilever.convergence.csv")).unwrap();
-    assert!(csv.starts_with("increment,load_factor,attempt,augmentation,iteration,residual,energy,contact_active,seconds_contact,seconds_assembly,seconds_factor,seconds_solve"));
+    assert!(csv.starts_with("increment,load_factor,attempt,augmentation,iteration,residual,energy,contact_active,seconds_contact,seconds_assembly,seconds_factor,seconds_solve,krylov_iterations\n"));
     assert!(csv.lines().count() > 10);
 }
 

@@ -99,6 +99,15 @@ fn gamg_gives_the_direct_answer_on_one_rank_and_on_two() {
     assert!(corrections(&one).abs_diff(corrections(&direct)) <= 3, "{} against {}", corrections(&one), corrections(&direct));
     let k1 = krylov_per_solve(&log);
     assert!(k1 > 1.0 && k1 <= 60.0, "{k1} Krylov iterations per solve");
+    // the convergence CSV carries each solve's Krylov iterations: they add up to the
+    // log's total
+    let csv = std::fs::read_to_string(dir.join("one.convergence.csv")).unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let col = header.iter().position(|h| *h == "krylov_iterations").expect("krylov_iterations column");
+    let sum: u64 = csv.lines().skip(1).map(|l| l.split(',').nth(col).unwrap().parse::<u64>().unwrap()).sum();
+    let line = log.lines().find(|l| l.starts_with("linear solver petsc-gamg:")).unwrap();
+    let total: u64 = line.split(" Krylov iterations").next().unwrap().rsplit(' ').next().unwrap().parse().unwrap();
+    assert_eq!(sum, total, "{line}");
 
     let o = solve(&dir, Some(2), "petsc.yaml", "two.scres", &[]);
     let log = stderr(&o);
