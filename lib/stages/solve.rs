@@ -103,6 +103,13 @@ pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, 
             }
         ));
     }
+    if !setup.linear_solver.petsc.options.trim().is_empty() && !newton.linear_solver_name().starts_with("petsc") {
+        log.warning(&format!(
+            "PETSc options are given (petsc.options or --petsc-options) but the linear solver is {}: they are ignored{}",
+            newton.linear_solver_name(),
+            if cfg!(feature = "petsc") { " (linear_solver: petsc uses them)" } else { " (this build has no PETSc backend: --features petsc)" }
+        ));
+    }
     log.line(&format!(
         "{}: {} nodes, {} hexahedra, {} free dofs, {} nonzeros{}, {} increments, linear solver {}",
         input.display(),

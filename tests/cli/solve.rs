@@ -282,3 +282,16 @@ fn under_mpirun_a_build_without_petsc_runs_serially_on_rank_0() {
     assert!(o.status.success() && stderr(&o).is_empty(), "{}", stderr(&o));
     assert!(!dir.path().join("r1.scres").exists());
 }
+
+/// PETSc options given to a solve that does not use PETSc are not silently dropped:
+/// the run says they are ignored (a warning, also under -q) and solves.
+#[test]
+fn petsc_options_without_the_petsc_solver_are_reported_as_ignored() {
+    let dir = tempdir();
+    imported_cantilever(dir.path());
+    write_setup(dir.path(), &format!("{GOOD}linear_solver: direct\n"));
+    let o = run("sc-solve", &["c.scmesh", "--setup", "setup.yaml", "-o", "r.scres", "-q", "--petsc-options", "-ksp_monitor"], dir.path());
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("warning: PETSc options are given") && err.contains("they are ignored"), "{err}");
+}
