@@ -37,7 +37,7 @@ pub struct BlockRows {
     /// Destination of each free dof's diagonal (the scale of the constrained rows).
     free_diag: Vec<u32>,
     /// Global dof of each free dof.
-    global_of_free_diag: Vec<u32>,
+    global_of_free: Vec<u32>,
 }
 
 /// A pattern this layout cannot address.
@@ -110,7 +110,7 @@ impl BlockRows {
             is_free[g as usize] = true;
         }
         let constrained_diag = (0..3 * n_nodes).filter(|&g| !is_free[g]).map(|g| at(g, g)).collect();
-        Ok(Self { ptr, cols, dest, constrained_diag, free_diag, global_of_free_diag: global_of_free.to_vec() })
+        Ok(Self { ptr, cols, dest, constrained_diag, free_diag, global_of_free: global_of_free.to_vec() })
     }
 
     /// Number of node blocks stored.
@@ -126,40 +126,26 @@ impl BlockRows {
     /// Fills `block_values` (length `9·n_blocks`) with the full system: `K_ff`'s
     /// values (CSC order), zeros where only a constrained dof meets, and
     /// `d = mean |diag K_ff|` on the constrained diagonal. Collects into
-    /// `non_positive` the free diagonal entries that are not positive, as (global
-    /// dof, position in `block_values`, value): an indefinite tangent, which a
-    /// multigrid preconditioner cannot be built from as it stands.
-    pub fn scatter(&self, values: &[f64], block_values: &mut [f64], non_positive: &mut Vec<(usize, usize, f64)>) {
+    /// `non_positive` the global dofs whose free diagonal entry is not positive: an
+    /// indefinite tangent, from which a multigrid preconditioner cannot be built.
+    pub fn scatter(&self, values: &[f64], block_values: &mut [f64], non_positive: &mut Vec<usize>) {
         block_values.iter_mut().for_each(|v| *v = 0.0);
         for (&d, &v) in self.dest.iter().zip(values) {
             block_values[d as usize] = v;
         }
         non_positive.clear();
         let mut sum = 0.0;
-        for (f, &d) in self.free_diag.iter().enumerate() {
+        for (&d, &g) in self.free_diag.iter().zip(&self.global_of_free) {
             let v = block_values[d as usize];
             sum += v.abs();
             if !(v > 0.0) {
-                non_positive.push((self.global_of_free_diag[f] as usize, d as usize, v));
+                non_positive.push(g as usize);
             }
         }
-        let scale = self.diagonal_scale(sum);
+        let scale = if self.free_diag.is_empty() || sum == 0.0 { 1.0 } else { sum / self.free_diag.len() as f64 };
         for &d in &self.constrained_diag {
             block_values[d as usize] = scale;
         }
-    }
-
-    fn diagonal_scale(&self, sum: f64) -> f64 {
-        if self.free_diag.is_empty() || sum == 0.0 {
-            1.0
-        } else {
-            sum / self.free_diag.len() as f64
-        }
-    }
-
-    /// The scale `d` of the constrained diagonal in `block_values` (after `scatter`).
-    pub fn constrained_scale(&self, block_values: &[f64]) -> f64 {
-        self.diagonal_scale(self.free_diag.iter().map(|&d| block_values[d as usize].abs()).sum())
     }
 
     /// Block columns of block row `i`, and the offset of its values.
@@ -224,7 +210,6 @@ mod tests {
         let mut bv = vec![0.0; 9];
         let mut bad = Vec::new();
         b.scatter(&[1.0, -2.0, 0.0], &mut bv, &mut bad);
-        assert_eq!(bad, vec![(1, 4, -2.0), (2, 8, 0.0)]);
-        assert_eq!(b.constrained_scale(&bv), 1.0);
+        assert_eq!(bad, vec![1, 2]);
     }
 }

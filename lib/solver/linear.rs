@@ -116,8 +116,6 @@ pub struct SolveReport {
     pub krylov_iterations: usize,
     /// Why an iterative backend solved this system by its direct fallback.
     pub fallback: Option<String>,
-    /// Anything else the log should say about this solve.
-    pub note: Option<String>,
 }
 
 /// Linear-solver failures.
@@ -180,10 +178,6 @@ pub trait LinearSolver: Send {
     /// displacement vector, before `factor` (a multigrid backend builds its
     /// rigid-body near-null space from them); others ignore it.
     fn set_configuration(&mut self, _reference: &[nalgebra::Vector3<f64>], _u: &[f64]) {}
-    /// Whether [`LinearSolver::set_configuration`] is read (saves the caller the call).
-    fn wants_configuration(&self) -> bool {
-        false
-    }
 }
 
 /// Widest supernode (columns) from which [`FaerDirect`] runs faer in parallel when

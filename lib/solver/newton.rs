@@ -167,25 +167,7 @@ impl<'p> Newton<'p> {
         for def in &problem.contact {
             contact.push(PairSolver::new(def, &problem.X)?);
         }
-        let partition = Partition::of(problem, &linear_setup);
-        let (mut owners, mut groups) = (Vec::new(), NodeGroups::new());
-        contact_groups(problem, &mut contact, &vec![0.0; DOFS_PER_NODE * problem.n_nodes()], &mut groups, &mut owners)?;
-        if let Some(part) = &partition {
-            part.keep_local_groups(&mut groups, &mut owners);
-        }
-        for pair in &mut contact {
-            pair.init_history();
-        }
-        let pattern = match &partition {
-            Some(part) => Pattern::build(problem.dofs.clone(), &part.hexes, groups)?,
-            None => Pattern::build(problem.dofs.clone(), &problem.hexes, groups)?,
-        };
-        let assembly = Assembly::new(&pattern)?;
-        if !problem.symmetric() && matches!(choice, LinearSolverChoice::Cholesky | LinearSolverChoice::Ldlt) {
-            let why = if problem.pressure_faces.is_empty() { "friction" } else { "follower pressure" };
-            return Err(SetupFailure::NotSymmetric(if choice == LinearSolverChoice::Cholesky { "cholesky" } else { "ldlt" }, why));
-        }
-        let (_, ranks) = super::ranks::rank_and_size();
+        let (_, ranks) = ranks::rank_and_size();
         let n_dofs = (DOFS_PER_NODE * problem.n_nodes()) as u64;
         let petsc = match choice {
             LinearSolverChoice::Petsc => true,
@@ -201,6 +183,23 @@ impl<'p> Newton<'p> {
                 _ => "direct",
             };
             return Err(SetupFailure::DirectUnderMpi(ranks, name));
+        }
+        // several ranks share the work (only the PETSc backend can: checked above)
+        let partition = (ranks > 1).then(|| Partition::new(problem));
+        let (mut owners, mut groups) = (Vec::new(), NodeGroups::new());
+        contact_groups(problem, &mut contact, &vec![0.0; DOFS_PER_NODE * problem.n_nodes()], &mut groups, &mut owners)?;
+        if let Some(part) = &partition {
+            part.keep_local_groups(&mut groups, &mut owners);
+        }
+        for pair in &mut contact {
+            pair.init_history();
+        }
+        let hexes = partition.as_ref().map_or(&problem.hexes[..], |part| &part.hexes[..]);
+        let pattern = Pattern::build(problem.dofs.clone(), hexes, groups)?;
+        let assembly = Assembly::new(&pattern)?;
+        if !problem.symmetric() && matches!(choice, LinearSolverChoice::Cholesky | LinearSolverChoice::Ldlt) {
+            let why = if problem.pressure_faces.is_empty() { "friction" } else { "follower pressure" };
+            return Err(SetupFailure::NotSymmetric(if choice == LinearSolverChoice::Cholesky { "cholesky" } else { "ldlt" }, why));
         }
         let (symmetry, strategy) = match choice {
             LinearSolverChoice::Auto | LinearSolverChoice::Direct | LinearSolverChoice::Petsc if problem.symmetric() => {
@@ -428,7 +427,7 @@ impl<'p> Newton<'p> {
                 (None, Some(f))
             }
         };
-        if let Some(part) = &self.partition {
+        if self.partition.is_some() {
             // every rank takes the same branch: the worst failure of any rank decides
             let local = failure.as_ref().map_or(0.0, AssemblyFailure::severity);
             let mut worst = [local];
@@ -436,23 +435,18 @@ impl<'p> Newton<'p> {
             if worst[0] > local {
                 return Err(AssemblyFailure::OtherRank(worst[0] as u8));
             }
-            if let Some(f) = failure {
-                return Err(f);
-            }
-            // this rank's residual is complete on the dofs of its nodes only: those,
-            // summed over the ranks, give every rank the whole residual
-            let (a, b) = (DOFS_PER_NODE * part.first, DOFS_PER_NODE * part.last);
-            for (d, ((out, r), f)) in self.residual.iter_mut().zip(full.unwrap_or(&[])).zip(&self.f_ext).enumerate() {
-                *out = if d >= a && d < b { r - f } else { 0.0 };
-            }
+        }
+        if let Some(f) = failure {
+            return Err(f);
+        }
+        // the dofs whose residual this rank has whole: all, or those of its nodes
+        let (a, b) = self.partition.as_ref().map_or((0, self.residual.len()), |part| (DOFS_PER_NODE * part.first, DOFS_PER_NODE * part.last));
+        for (d, ((out, r), f)) in self.residual.iter_mut().zip(full.unwrap_or(&[])).zip(&self.f_ext).enumerate() {
+            *out = if d >= a && d < b { r - f } else { 0.0 };
+        }
+        if self.partition.is_some() {
+            // summed over the ranks, the complete parts give every rank the whole residual
             ranks::reduce_over_ranks(&mut self.residual, ranks::Reduction::Sum).map_err(AssemblyFailure::Mpi)?;
-        } else {
-            if let Some(f) = failure {
-                return Err(f);
-            }
-            for ((out, r), f) in self.residual.iter_mut().zip(full.unwrap_or(&[])).zip(&self.f_ext) {
-                *out = r - f;
-            }
         }
         if let Some(s) = &self.stabilization {
             s.add_residual(u, &mut self.residual);
@@ -620,9 +614,7 @@ impl<'p> Newton<'p> {
                 }
             }
             let t = Instant::now();
-            if self.linear.wants_configuration() {
-                self.linear.set_configuration(&self.problem.X, u);
-            }
+            self.linear.set_configuration(&self.problem.X, u);
             self.linear.factor(self.assembly.values()).map_err(|error| IncrementFailure::Linear { iteration, error })?;
             row.seconds_factor = t.elapsed().as_secs_f64();
             if self.inexact_newton {
@@ -637,7 +629,7 @@ impl<'p> Newton<'p> {
             row.seconds_solve = t.elapsed().as_secs_f64();
             let report = self.linear.last_solve();
             row.krylov_iterations = report.krylov_iterations as u32;
-            if let Some(why) = report.fallback.or(report.note) {
+            if let Some(why) = report.fallback {
                 self.linear_notes.push(format!("iteration {iteration}: {why}"));
             }
             if iteration == 0 {
@@ -723,17 +715,13 @@ struct Partition {
 }
 
 impl Partition {
-    /// This rank's share, when the linear solver is distributed over several ranks.
-    fn of(problem: &Problem, setup: &LinearSolverSetup) -> Option<Self> {
-        let (_, size) = ranks::rank_and_size();
-        if size < 2 || !matches!(setup.method, LinearSolverChoice::Petsc | LinearSolverChoice::Auto) {
-            return None;
-        }
+    /// This rank's share of `problem`.
+    fn new(problem: &Problem) -> Self {
         let (first, last) = ranks::owned_nodes(problem.n_nodes());
         let mine = |n: &u32| (*n as usize) >= first && (*n as usize) < last;
         let hex_ids: Vec<u32> = (0..problem.hexes.len() as u32).filter(|&e| problem.hexes[e as usize].iter().any(mine)).collect();
         let hexes = hex_ids.iter().map(|&e| problem.hexes[e as usize]).collect();
-        Some(Self { first, last, hex_ids, hexes })
+        Self { first, last, hex_ids, hexes }
     }
 
     /// Keeps the groups that touch this rank's nodes (and their owners).

@@ -304,7 +304,7 @@ impl LinearSolver for SymmetricPartGmres {
         let start = Instant::now();
         self.n_solve += 1;
         if let Some(reason) = &self.lu_reason {
-            self.last = SolveReport { krylov_iterations: 0, fallback: Some(format!("{reason}: solved by LU instead")), note: None };
+            self.last = SolveReport { krylov_iterations: 0, fallback: Some(format!("{reason}: solved by LU instead")) };
             let r = self.lu.solve_in_place(rhs);
             self.solve_time += start.elapsed();
             return r;
@@ -327,7 +327,7 @@ impl LinearSolver for SymmetricPartGmres {
         let result = match outcome {
             Ok(o) if o.converged => {
                 self.last_iterations = iterations;
-                self.last = SolveReport { krylov_iterations: iterations, fallback: None, note: None };
+                self.last = SolveReport { krylov_iterations: iterations, fallback: None };
                 Ok(())
             }
             other => {
@@ -345,7 +345,7 @@ impl LinearSolver for SymmetricPartGmres {
                 self.numeric_time += t.elapsed();
                 factored?;
                 rhs.copy_from_slice(&self.rhs);
-                self.last = SolveReport { krylov_iterations: iterations, fallback: Some(format!("{why}: solved by LU instead")), note: None };
+                self.last = SolveReport { krylov_iterations: iterations, fallback: Some(format!("{why}: solved by LU instead")) };
                 self.lu.solve_in_place(rhs)
             }
         };

@@ -138,10 +138,10 @@ pub struct PetscKrylov {
     /// Iterations of the first solve after the last rebuild.
     base_iterations: Option<usize>,
     last_iterations: usize,
-    /// The last factored matrix's non-positive free diagonal entries (global dof,
-    /// position in `block_values`, value).
-    indefinite: Vec<(usize, usize, f64)>,
-    /// Their number over all ranks.
+    /// Scratch: the global dofs of the last factored matrix's non-positive free
+    /// diagonal entries.
+    non_positive: Vec<usize>,
+    /// Their number in this rank's rows, summed over all ranks (0: definite).
     indefinite_total: usize,
     eta: f64,
     report: SolveReport,
@@ -176,7 +176,7 @@ impl PetscKrylov {
             rebuild: true,
             base_iterations: None,
             last_iterations: 0,
-            indefinite: Vec::new(),
+            non_positive: Vec::new(),
             indefinite_total: 0,
             eta: 0.0,
             report: SolveReport::default(),
@@ -375,12 +375,11 @@ impl LinearSolver for PetscKrylov {
                 None => LinearSolverError::Backend("another MPI rank's tangent has a non-finite value".into()),
             });
         }
-        rows.scatter(values, &mut self.block_values, &mut self.indefinite);
+        rows.scatter(values, &mut self.block_values, &mut self.non_positive);
         let (first, last) = self.owned;
         // only this rank's rows are complete (and inserted); whether the tangent is
         // indefinite is decided by all ranks together, as what follows is collective
-        self.indefinite.retain(|&(g, _, _)| g >= 3 * first && g < 3 * last);
-        let mut count = [self.indefinite.len() as f64];
+        let mut count = [self.non_positive.iter().filter(|&&g| g >= 3 * first && g < 3 * last).count() as f64];
         runtime::reduce_over_ranks(&mut count, Reduction::Sum).map_err(|e| LinearSolverError::Backend(e.to_string()))?;
         self.indefinite_total = count[0] as usize;
         unsafe {
@@ -455,7 +454,6 @@ impl LinearSolver for PetscKrylov {
             self.rebuild = true;
             self.solve_direct(&why)?;
             self.report.fallback = Some(format!("{why}: solved by MUMPS (direct) instead"));
-            self.rebuild = true;
         } else {
             let rtol = self.eta.max(self.settings.tolerance);
             let mut reason: c_int = 0;
@@ -491,8 +489,7 @@ impl LinearSolver for PetscKrylov {
             }
             check("VecRestoreArrayRead", VecRestoreArrayRead(self.x_all, &mut a))?;
         }
-        if let Some(index) = rhs.iter().position(|v| !v.is_finite()) {
-            let _ = index;
+        if rhs.iter().any(|v| !v.is_finite()) {
             return Err(LinearSolverError::Singular { dof: None });
         }
         self.timings.solve += start.elapsed();
@@ -510,10 +507,6 @@ impl LinearSolver for PetscKrylov {
 
     fn set_forcing(&mut self, eta: f64) {
         self.eta = eta;
-    }
-
-    fn wants_configuration(&self) -> bool {
-        true
     }
 
     fn set_configuration(&mut self, reference: &[Vector3<f64>], u: &[f64]) {
