@@ -1,7 +1,8 @@
 //! Global assembly: dof numbering with Dirichlet elimination ([`dofs`]), the
-//! sparsity pattern of `K_ff` built once ([`pattern`]), and the parallel,
-//! deterministic element scatter ([`scatter`]).
+//! sparsity pattern of `K_ff` built once ([`pattern`]), the element colouring
+//! ([`colouring`]), and the parallel, deterministic element scatter ([`scatter`]).
 
+pub mod colouring;
 pub mod dofs;
 pub mod pattern;
 pub mod scatter;

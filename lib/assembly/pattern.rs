@@ -25,6 +25,7 @@
 use faer::sparse::{SymbolicSparseColMat, SymbolicSparseColMatRef};
 use rayon::prelude::*;
 
+use super::colouring::Colouring;
 use super::dofs::{DofMap, DOFS_PER_NODE};
 
 /// Slot of an element-matrix entry that touches a constrained dof (dropped).
@@ -112,6 +113,8 @@ impl<'a> FromIterator<&'a [u32]> for NodeGroups {
 pub struct Pattern {
     dofs: DofMap,
     hexes: Vec<[u32; 8]>,
+    /// The hexahedra in colours that share no node (the assembly's parallel order).
+    colouring: Colouring,
     groups: NodeGroups,
     symbolic: SymbolicSparseColMat<usize>,
     /// `n_hex · 576`, column-major per element.
@@ -124,6 +127,11 @@ pub struct Pattern {
 impl Pattern {
     /// Builds the pattern from hexahedra and contact node groups.
     pub fn build(dofs: DofMap, hexes: &[[u32; 8]], groups: NodeGroups) -> Result<Self, PatternError> {
+        Self::build_coloured(dofs, hexes, None, groups)
+    }
+
+    /// [`Self::build`], with the hexahedra's colouring when it is known already.
+    fn build_coloured(dofs: DofMap, hexes: &[[u32; 8]], colouring: Option<Colouring>, groups: NodeGroups) -> Result<Self, PatternError> {
         let n_nodes = dofs.n_nodes();
         for (e, hex) in hexes.iter().enumerate() {
             if let Some(&node) = hex.iter().find(|&&a| a as usize >= n_nodes) {
@@ -238,9 +246,11 @@ impl Pattern {
         }
 
         let symbolic = SymbolicSparseColMat::new_checked(n_free, n_free, col_ptr, None, row_idx);
+        let colouring = colouring.unwrap_or_else(|| Colouring::greedy(n_nodes, hexes.iter().map(|h| &h[..])));
         Ok(Self {
             dofs,
             hexes: hexes.to_vec(),
+            colouring,
             groups,
             symbolic,
             hex_slots,
@@ -252,7 +262,12 @@ impl Pattern {
     /// The same dofs and hexahedra with new contact groups (the pattern and every
     /// slot map are rebuilt; the solver must then `analyse` again).
     pub fn with_groups(&self, groups: NodeGroups) -> Result<Self, PatternError> {
-        Self::build(self.dofs.clone(), &self.hexes, groups)
+        Self::build_coloured(self.dofs.clone(), &self.hexes, Some(self.colouring.clone()), groups)
+    }
+
+    /// The hexahedra in colours that share no node.
+    pub fn colouring(&self) -> &Colouring {
+        &self.colouring
     }
 
     pub fn dofs(&self) -> &DofMap {

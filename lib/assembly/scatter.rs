@@ -1,29 +1,27 @@
 //! Parallel, deterministic assembly of the reduced stiffness values and the full
 //! residual from per-element contributions.
 //!
-//! **Two phases.**
-//! 1. *Compute*, in parallel over elements (rayon): each element writes its
-//!    residual `r_e` and tangent `k_e` into its own buffer in the workspace.
-//!    Nothing is shared, so the result of an element does not depend on which
-//!    thread ran it.
-//! 2. *Sum*, in parallel over value slots (and over dofs for the residual): each
-//!    slot adds up its contributions from a precomputed "slot → contributions"
-//!    list (CSR, the transpose of the element slot maps), always in the same
-//!    order — hexahedra by increasing index, then contact groups by increasing
-//!    index. Every sum is a fixed sequence of floating-point additions, so
-//!    `values` and `residual` are **bit-identical at any thread count** (and equal
-//!    to a sequential assembly in element order).
+//! **Stiffness: colour by colour.** The hexahedra are split into colours that share
+//! no node ([`Colouring`], built with the pattern). The elements of one colour are
+//! computed in parallel (rayon), and each adds its 24 × 24 matrix straight into the
+//! values array through its slot map: two elements of one colour have no common
+//! row, so no entry is written by two threads. The colours follow one another in
+//! a fixed order, so every entry receives its contributions in the same sequence
+//! at any thread count: `values` is **bit-identical at any thread count**. No
+//! element matrix is kept: at 1M dofs that saves the 1.5 GB of buffers (8 bytes
+//! per element-matrix entry) and the 1.4 GB of "entry → contributions" lists that
+//! a buffer-and-gather scheme needs.
 //!
-//! The alternative, element colouring (elements of one colour share no node, so
-//! they can add into `values` directly in parallel), needs no buffers but needs
-//! `unsafe` shared writes, a barrier per colour, and a new colouring whenever the
-//! contact groups change. The buffer + gather scheme needs no `unsafe`; it costs
-//! 8 bytes per element-matrix entry of buffer plus 4 bytes of contribution list,
-//! and [`Assembly::timings`] reports the sum phase separately so its cost can be
-//! compared with the element computation (see `solver::bench`; colouring was not
-//! implemented).
+//! **Contact groups** (a few thousand, each 3k × 3k) are computed in parallel into
+//! their own buffers and then added in group order, one after another.
 //!
-//! **No allocation per iteration.** [`Assembly`] owns the element buffers, the
+//! **Residual: buffer and gather.** Each element writes its residual into its own
+//! 24-vector; every dof then sums its contributions from a precomputed
+//! "dof → contributions" list in a fixed order (hexahedra by increasing index,
+//! then groups), in parallel over dofs: the residual is bit-identical at any
+//! thread count too, and costs 8 + 4 bytes per element dof.
+//!
+//! **No allocation per iteration.** [`Assembly`] owns the buffers, the
 //! contribution lists and the output arrays; it is built once per [`Pattern`]
 //! (rebuilt with it when the contact groups change) and reused by every Newton
 //! iteration.
@@ -36,6 +34,7 @@
 use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 use rayon::prelude::*;
 
+use super::colouring::Colouring;
 use super::dofs::DOFS_PER_NODE;
 use super::pattern::{Pattern, HEX_DOFS, HEX_ENTRIES, NO_SLOT};
 
@@ -103,10 +102,42 @@ impl<T: Copy + Default> Contributions<T> {
 /// Wall times of the last assembly, by phase.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct AssemblyTimings {
-    /// Element routines (parallel over elements).
+    /// Element routines and the hexahedra's additions into the values (parallel
+    /// over the elements of each colour), contact group routines.
     pub compute: std::time::Duration,
-    /// Fixed-order sums into values and residual (parallel over outputs).
+    /// The groups' additions into the values and the residual's fixed-order sums.
     pub sum: std::time::Duration,
+}
+
+/// A slice shared by the elements of one colour, each of which touches only
+/// entries no other element of the colour touches (see the module docs): the
+/// stiffness values of its rows, its own residual buffer.
+struct ColourWrites<T> {
+    ptr: *mut T,
+    len: usize,
+}
+
+// SAFETY: entries are only reached through `get`, whose callers (the elements of
+// one colour) touch disjoint entries; the slice outlives the colour's pass.
+unsafe impl<T: Send> Send for ColourWrites<T> {}
+unsafe impl<T: Send> Sync for ColourWrites<T> {}
+
+impl<T> ColourWrites<T> {
+    fn new(slice: &mut [T]) -> Self {
+        Self { ptr: slice.as_mut_ptr(), len: slice.len() }
+    }
+
+    /// Entry `i`.
+    ///
+    /// # Safety
+    /// No other thread reads or writes entry `i` while the reference lives.
+    #[inline]
+    #[allow(clippy::mut_from_ref)]
+    unsafe fn get(&self, i: usize) -> &mut T {
+        assert!(i < self.len);
+        // SAFETY: in bounds (checked); exclusive by the caller's contract
+        unsafe { &mut *self.ptr.add(i) }
+    }
 }
 
 /// Assembly workspace for one [`Pattern`]: element buffers, contribution lists
@@ -117,14 +148,9 @@ pub struct Assembly {
     n_hex: usize,
     n_groups: usize,
     nnz: usize,
-    k_hex: Vec<HexMatrix>,
     r_hex: Vec<HexVector>,
     k_grp: Vec<DMatrix<f64>>,
     r_grp: Vec<DVector<f64>>,
-    /// slot -> `e·576 + local entry`.
-    hex_to_slot: Contributions<u32>,
-    /// slot -> (group, local entry).
-    grp_to_slot: Contributions<(u32, u32)>,
     /// dof -> `e·24 + local dof`.
     hex_to_dof: Contributions<u32>,
     /// dof -> (group, local dof).
@@ -151,22 +177,6 @@ impl Assembly {
         let nnz = pattern.nnz();
         let n_dofs = pattern.dofs().n_dofs();
 
-        let hex_to_slot = Contributions::build(
-            nnz,
-            (0..n_hex).flat_map(|e| {
-                pattern.hex_slots(e).iter().enumerate().filter(|(_, &s)| s != NO_SLOT).map(
-                    move |(l, &s)| (s as usize, (e * HEX_ENTRIES + l) as u32),
-                )
-            }),
-        );
-        let grp_to_slot = Contributions::build(
-            nnz,
-            (0..groups.len()).flat_map(|g| {
-                pattern.group_slots(g).iter().enumerate().filter(|(_, &s)| s != NO_SLOT).map(
-                    move |(l, &s)| (s as usize, (g as u32, l as u32)),
-                )
-            }),
-        );
         let hexes = pattern.hexes();
         let hex_to_dof = Contributions::build(
             n_dofs,
@@ -190,12 +200,9 @@ impl Assembly {
             n_hex,
             n_groups: groups.len(),
             nnz,
-            k_hex: vec![HexMatrix::zeros(); n_hex],
             r_hex: vec![HexVector::zeros(); n_hex],
             k_grp: (0..groups.len()).map(|g| DMatrix::zeros(nd(g), nd(g))).collect(),
             r_grp: (0..groups.len()).map(|g| DVector::zeros(nd(g))).collect(),
-            hex_to_slot,
-            grp_to_slot,
             hex_to_dof,
             grp_to_dof,
             values: vec![0.0; nnz],
@@ -212,12 +219,9 @@ impl Assembly {
             n_hex: 0,
             n_groups: 0,
             nnz: 0,
-            k_hex: Vec::new(),
             r_hex: Vec::new(),
             k_grp: Vec::new(),
             r_grp: Vec::new(),
-            hex_to_slot: Contributions::default(),
-            grp_to_slot: Contributions::default(),
             hex_to_dof: Contributions::default(),
             grp_to_dof: Contributions::default(),
             values: Vec::new(),
@@ -266,19 +270,43 @@ impl Assembly {
         G: Fn(usize, &mut DVector<f64>, &mut DMatrix<f64>) -> Result<(), E> + Sync,
     {
         assert!(self.fits(pattern), "Assembly workspace used with a different pattern than it was built for");
-        // Phase 1: element contributions into private buffers.
+        // Phase 1: the hexahedra, colour by colour, add into the values; their
+        // residuals and the groups go to private buffers.
         let start = std::time::Instant::now();
-        let hex_failure = self
-            .k_hex
-            .par_iter_mut()
-            .zip(self.r_hex.par_iter_mut())
-            .enumerate()
-            .filter_map(|(e, (k, r))| {
-                k.fill(0.0);
-                r.fill(0.0);
-                element(e, r, k).err().map(|error| (e, error))
-            })
-            .min_by_key(|(e, _)| *e);
+        self.values.par_iter_mut().for_each(|v| *v = 0.0);
+        let values = ColourWrites::new(&mut self.values);
+        let residuals = ColourWrites::new(&mut self.r_hex);
+        let colouring: &Colouring = pattern.colouring();
+        let mut hex_failure: Option<(usize, E)> = None;
+        for c in 0..colouring.n_colours() {
+            let failure = colouring
+                .colour(c)
+                .par_iter()
+                .filter_map(|&e| {
+                    let e = e as usize;
+                    // SAFETY: every element of the colour has its own residual buffer
+                    let r = unsafe { residuals.get(e) };
+                    r.fill(0.0);
+                    let mut k = HexMatrix::zeros();
+                    if let Err(error) = element(e, r, &mut k) {
+                        return Some((e, error));
+                    }
+                    for (&slot, &v) in pattern.hex_slots(e).iter().zip(k.as_slice()) {
+                        if slot != NO_SLOT {
+                            // SAFETY: the elements of one colour share no node, hence
+                            // no row: no other thread touches this entry
+                            unsafe { *values.get(slot as usize) += v };
+                        }
+                    }
+                    None
+                })
+                .min_by_key(|(e, _)| *e);
+            if let Some((e, error)) = failure {
+                if hex_failure.as_ref().is_none_or(|(w, _)| e < *w) {
+                    hex_failure = Some((e, error));
+                }
+            }
+        }
         if let Some((element, error)) = hex_failure {
             return Err(ElementFailure::Hex { element, error });
         }
@@ -296,26 +324,18 @@ impl Assembly {
         if let Some((group, error)) = group_failure {
             return Err(ElementFailure::Group { group, error });
         }
-
-        // Phase 2: fixed-order sums, parallel over outputs.
         self.timings.compute = start.elapsed();
+
+        // Phase 2: the groups' matrices in group order, and the residual's
+        // fixed-order sums, parallel over dofs.
         let start = std::time::Instant::now();
-        let (k_hex, k_grp) = (&self.k_hex, &self.k_grp);
-        let (hex_to_slot, grp_to_slot) = (&self.hex_to_slot, &self.grp_to_slot);
-        self.values.par_chunks_mut(GATHER_CHUNK).enumerate().for_each(|(c, chunk)| {
-            for (k, v) in chunk.iter_mut().enumerate() {
-                let s = c * GATHER_CHUNK + k;
-                let mut sum = 0.0;
-                for &src in hex_to_slot.of(s) {
-                    let src = src as usize;
-                    sum += k_hex[src / HEX_ENTRIES][src % HEX_ENTRIES];
+        for (g, k) in self.k_grp.iter().enumerate() {
+            for (&slot, &v) in pattern.group_slots(g).iter().zip(k.as_slice()) {
+                if slot != NO_SLOT {
+                    self.values[slot as usize] += v;
                 }
-                for &(g, l) in grp_to_slot.of(s) {
-                    sum += k_grp[g as usize][l as usize];
-                }
-                *v = sum;
             }
-        });
+        }
         let (r_hex, r_grp) = (&self.r_hex, &self.r_grp);
         let (hex_to_dof, grp_to_dof) = (&self.hex_to_dof, &self.grp_to_dof);
         self.residual.par_chunks_mut(GATHER_CHUNK).enumerate().for_each(|(c, chunk)| {
@@ -359,13 +379,12 @@ impl Assembly {
     /// Bytes held by the workspace (element buffers and contribution lists).
     pub fn memory_bytes(&self) -> usize {
         use std::mem::size_of;
-        self.k_hex.len() * size_of::<HexMatrix>()
-            + self.r_hex.len() * size_of::<HexVector>()
+        self.r_hex.len() * size_of::<HexVector>()
             + self.k_grp.iter().map(|k| k.len() * 8).sum::<usize>()
             + self.r_grp.iter().map(|r| r.len() * 8).sum::<usize>()
-            + (self.hex_to_slot.src.len() + self.hex_to_dof.src.len()) * 4
-            + (self.grp_to_slot.src.len() + self.grp_to_dof.src.len()) * 8
-            + (self.hex_to_slot.ptr.len() * 2 + self.hex_to_dof.ptr.len() * 2) * 8
+            + self.hex_to_dof.src.len() * 4
+            + self.grp_to_dof.src.len() * 8
+            + (self.hex_to_dof.ptr.len() + self.grp_to_dof.ptr.len()) * 8
             + (self.values.len() + self.residual.len()) * 8
     }
 }
@@ -421,15 +440,16 @@ mod tests {
         let mut asm = Assembly::new(&p).unwrap();
         let (values, residual) = asm.assemble_with_groups(&p, hex_contribution, group_contribution).unwrap();
 
-        // Dense reference, element order then group order.
+        // Dense reference in the documented orders: the stiffness colour by colour
+        // (any order within a colour: no entry gets two terms from one), then the
+        // groups; the residual by element index, then the groups.
         let (n, nd) = (dofs.n_free(), dofs.n_dofs());
         let mut dense = vec![vec![0.0f64; n]; n];
         let mut r_ref = vec![0.0f64; nd];
-        let mut add = |nodes: &[u32], r: &[f64], k: &dyn Fn(usize, usize) -> f64| {
+        let mut add_k = |nodes: &[u32], k: &dyn Fn(usize, usize) -> f64| {
             let m = 3 * nodes.len();
             for j in 0..m {
                 let gj = 3 * nodes[j / 3] as usize + j % 3;
-                r_ref[gj] += r[j];
                 for i in 0..m {
                     let gi = 3 * nodes[i / 3] as usize + i % 3;
                     if let (Some(a), Some(b)) = (dofs.free(gi), dofs.free(gj)) {
@@ -438,16 +458,35 @@ mod tests {
                 }
             }
         };
-        for (e, hex) in p.hexes().iter().enumerate() {
-            let (mut r, mut k) = (HexVector::zeros(), HexMatrix::zeros());
-            hex_contribution(e, &mut r, &mut k).unwrap();
-            add(hex, r.as_slice(), &|i, j| k[(i, j)]);
+        assert!(p.colouring().n_colours() > 1);
+        for c in 0..p.colouring().n_colours() {
+            for &e in p.colouring().colour(c).iter().rev() {
+                let (mut r, mut k) = (HexVector::zeros(), HexMatrix::zeros());
+                hex_contribution(e as usize, &mut r, &mut k).unwrap();
+                add_k(&p.hexes()[e as usize], &|i, j| k[(i, j)]);
+            }
         }
         for (g, nodes) in p.groups().iter().enumerate() {
             let m = 3 * nodes.len();
             let (mut r, mut k) = (DVector::zeros(m), DMatrix::zeros(m, m));
             group_contribution(g, &mut r, &mut k).unwrap();
-            add(nodes, r.as_slice(), &|i, j| k[(i, j)]);
+            add_k(nodes, &|i, j| k[(i, j)]);
+        }
+        let mut add_r = |nodes: &[u32], r: &[f64]| {
+            for (j, v) in r.iter().enumerate() {
+                r_ref[3 * nodes[j / 3] as usize + j % 3] += v;
+            }
+        };
+        for (e, hex) in p.hexes().iter().enumerate() {
+            let (mut r, mut k) = (HexVector::zeros(), HexMatrix::zeros());
+            hex_contribution(e, &mut r, &mut k).unwrap();
+            add_r(hex, r.as_slice());
+        }
+        for (g, nodes) in p.groups().iter().enumerate() {
+            let m = 3 * nodes.len();
+            let (mut r, mut k) = (DVector::zeros(m), DMatrix::zeros(m, m));
+            group_contribution(g, &mut r, &mut k).unwrap();
+            add_r(nodes, r.as_slice());
         }
         // Every stored entry matches bit for bit, and nothing outside the pattern.
         let mut stored = 0;

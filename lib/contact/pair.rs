@@ -521,6 +521,39 @@ impl PairSolver {
         (0..self.slaves.len()).filter(|&s| self.status[s] == SlaveStatus::Active).map(|s| -self.projections[s].g).fold(0.0, f64::max)
     }
 
+    /// The fraction α ∈ (0, 1] of a Newton correction `du(node)` that carries no
+    /// unpressed slave deeper than `depth · h_master` past the master, and the slave
+    /// node that decides it (`None` when the full correction does). A slave that is
+    /// not pressed has no contact stiffness in the tangent that made the correction,
+    /// so nothing in it stops the node at the master: at first contact the linear
+    /// predictor drives whole faces through the other body (see docs/theory.md,
+    /// "Penetration step limit"). The gap is linearised at the last search,
+    /// Δg = n̄·(Δx_s − Σ_A N_A Δx_A) (the variation of eq. 2.2's gap).
+    pub fn step_limit(&self, du: impl Fn(u32) -> Vec3, depth: f64) -> Option<(f64, u32)> {
+        let allowed = depth * self.h_master;
+        let mut limit: Option<(f64, u32)> = None;
+        for s in 0..self.slaves.len() {
+            if !self.usable(s) || self.pressed(s) {
+                continue;
+            }
+            let g = self.projections[s].g;
+            let sp = &self.points[s];
+            let mut dx = du(self.slaves[s]);
+            for (&k, &q) in sp.basis.nodes().iter().zip(sp.basis.q()) {
+                dx -= du(self.net[k]) * q;
+            }
+            let g_new = g + sp.n_bar.dot(&dx);
+            if g_new >= -allowed || g <= -allowed {
+                continue;
+            }
+            let alpha = (g + allowed) / (g - g_new);
+            if limit.is_none_or(|(a, _)| alpha < a) {
+                limit = Some((alpha, self.slaves[s]));
+            }
+        }
+        limit
+    }
+
     /// Largest elastic slip ‖t_T − t_{T,n}‖ / ε_T of a sticking node (0 without
     /// friction): the tangential constraint violation the augmentation removes.
     pub fn max_elastic_slip(&self) -> f64 {

@@ -192,6 +192,11 @@ pub struct NewtonSetup {
     /// the increment back.
     #[serde(default = "default_step_halvings")]
     pub max_step_halvings: u32,
+    /// Penetration step limit: the deepest a slave node without contact stiffness
+    /// may be carried past the master by one correction, in mean master edge
+    /// lengths; a longer correction is shortened to it (0: no limit).
+    #[serde(default = "default_penetration_step_limit")]
+    pub penetration_step_limit: f64,
 }
 
 fn default_max_iterations() -> u32 {
@@ -212,6 +217,9 @@ fn default_true() -> bool {
 fn default_step_halvings() -> u32 {
     6
 }
+fn default_penetration_step_limit() -> f64 {
+    0.5
+}
 
 impl Default for NewtonSetup {
     fn default() -> Self {
@@ -222,6 +230,7 @@ impl Default for NewtonSetup {
             search_updates: default_search_updates(),
             line_search: true,
             max_step_halvings: default_step_halvings(),
+            penetration_step_limit: default_penetration_step_limit(),
         }
     }
 }

@@ -1,5 +1,6 @@
 //! Solvers: the linear-solver interface and its faer direct backend ([`linear`]),
-//! fill-reducing orderings ([`ordering`]), GMRES ([`gmres`]) and the frictional
+//! fill-reducing orderings ([`ordering`]), GMRES ([`gmres`]), an inexact Newton's
+//! forcing terms ([`forcing`]) and the frictional
 //! tangent's symmetric-part-preconditioned solver ([`symmetric_part`]),
 //! the static problem ([`problem`]) and its load curves ([`amplitude`]), Newton–Raphson for one increment ([`newton`]),
 //! the augmented Lagrangian's Uzawa loop ([`uzawa`]), the master-surface
@@ -10,6 +11,7 @@
 pub mod amplitude;
 pub mod bench;
 pub mod block_rows;
+pub mod forcing;
 pub mod gmres;
 pub mod increments;
 pub mod linear;

@@ -15,6 +15,7 @@ use std::time::Instant;
 
 use nalgebra::{DMatrix, DVector, Vector3};
 
+use super::forcing::Forcing;
 use super::problem::Problem;
 use super::ranks;
 use super::stabilization::Stabilization;
@@ -29,6 +30,11 @@ use crate::solver::gmres::GmresSettings;
 use crate::solver::linear::{FaerDirect, FaerDirectOptions, LinearSolver, LinearSolverError, SolverTimings, SymmetricStrategy, Symmetry};
 use crate::solver::ordering::FillOrdering;
 use crate::solver::symmetric_part::SymmetricPartGmres;
+
+/// The loosest an inexact Newton's linear solve stops at (the first of each solve;
+/// [`Forcing`]). Looser first solves (1e-2) measured more Newton iterations on the
+/// frictional crossed beams.
+const FORCING_MAX: f64 = 1e-3;
 
 /// Why an increment did not converge.
 #[derive(Debug, Clone, thiserror::Error)]
@@ -148,11 +154,17 @@ pub struct Newton<'p> {
     /// The iteration at which the current solve held the contact search's master
     /// elements, and why ([`PairSolver::freeze`]); `None` while they may change.
     pub frozen_at: Option<(u32, &'static str)>,
-    /// What the linear solver had to say since the log last took these (an
-    /// iterative solve handed to its direct fallback).
-    pub linear_notes: Vec<String>,
-    /// Inexact Newton (an iterative linear solver's tolerance follows the residual).
-    inexact_newton: bool,
+    /// What the solve had to say since the log last took these (an iterative
+    /// solve handed to its direct fallback, a correction the penetration step
+    /// limit shortened).
+    pub notes: Vec<String>,
+    /// Corrections shortened by the penetration step limit (all solves).
+    pub penetration_limits: u32,
+    /// A full-length Newton correction (storage reused by the step limit).
+    du_full: Vec<f64>,
+    /// Inexact Newton: an iterative linear solver's tolerance follows the residual
+    /// (`None`: every solve to the solver's own tolerance).
+    forcing: Option<Forcing>,
 }
 
 /// A converged increment's iteration history.
@@ -236,6 +248,7 @@ impl<'p> Newton<'p> {
         let n = DOFS_PER_NODE * problem.n_nodes();
         let n_free = pattern.n_free();
         let stabilization = Stabilization::new(problem, &contact);
+        let forcing = linear_setup.inexact_newton.then(|| Forcing::new(FORCING_MAX, settings.residual_tolerance));
         Ok(Self {
             problem,
             settings,
@@ -256,8 +269,10 @@ impl<'p> Newton<'p> {
             line_search_steps: 0,
             stabilization,
             frozen_at: None,
-            linear_notes: Vec::new(),
-            inexact_newton: linear_setup.inexact_newton,
+            notes: Vec::new(),
+            penetration_limits: 0,
+            du_full: vec![0.0; n],
+            forcing,
         })
     }
 
@@ -478,6 +493,9 @@ impl<'p> Newton<'p> {
         let mut cycling = 0u32;
         self.release_contact();
         self.frozen_at = None;
+        if let Some(forcing) = &mut self.forcing {
+            forcing.restart();
+        }
         let dofs = &p.dofs;
         let mut last_r_norm = f64::INFINITY;
         for iteration in 0..=self.settings.max_iterations {
@@ -617,10 +635,8 @@ impl<'p> Newton<'p> {
             self.linear.set_configuration(&self.problem.X, u);
             self.linear.factor(self.assembly.values()).map_err(|error| IncrementFailure::Linear { iteration, error })?;
             row.seconds_factor = t.elapsed().as_secs_f64();
-            if self.inexact_newton {
-                // forcing term η = O(r): Newton stays quadratic (Dembo, Eisenstat &
-                // Steihaug 1982) while the early solves stop early
-                self.linear.set_forcing((1e-2 * residual).min(1e-3));
+            if let Some(forcing) = &mut self.forcing {
+                self.linear.set_forcing(forcing.next(residual));
             }
             let t = Instant::now();
             // K_ff Δu_f = −R_f; Δu is kept in r_free for the next energy norm.
@@ -630,16 +646,52 @@ impl<'p> Newton<'p> {
             let report = self.linear.last_solve();
             row.krylov_iterations = report.krylov_iterations as u32;
             if let Some(why) = report.fallback {
-                self.linear_notes.push(format!("iteration {iteration}: {why}"));
+                self.notes.push(format!("linear solver: iteration {iteration}: {why}"));
             }
             if iteration == 0 {
                 energy0 = self.r_free.iter().zip(&self.rhs).map(|(du, r)| du * r).sum::<f64>().abs();
             }
+            self.limit_penetration(iteration);
             dofs.add_free(&self.r_free, u);
             on_iteration(&row);
             log.push(row);
         }
         unreachable!("the loop returns at max_iterations")
+    }
+
+    /// Penetration step limit: shortens the correction Δu (in `r_free`) so that no
+    /// slave node without contact stiffness goes deeper than
+    /// `penetration_step_limit` master edge lengths past the master
+    /// ([`PairSolver::step_limit`]). Every MPI rank has the whole Δu and the same
+    /// search, so all take the same step.
+    fn limit_penetration(&mut self, iteration: u32) {
+        let depth = self.settings.penetration_step_limit;
+        if !(depth > 0.0) || self.contact.is_empty() {
+            return;
+        }
+        self.du_full.iter_mut().for_each(|d| *d = 0.0);
+        self.problem.dofs.add_free(&self.r_free, &mut self.du_full);
+        let du = &self.du_full;
+        let at = |n: u32| {
+            let d = DOFS_PER_NODE * n as usize;
+            Vector3::new(du[d], du[d + 1], du[d + 2])
+        };
+        let mut limit: Option<(f64, u32, usize)> = None;
+        for (k, pair) in self.contact.iter().enumerate() {
+            if let Some((alpha, node)) = pair.step_limit(at, depth) {
+                if limit.is_none_or(|(a, ..)| alpha < a) {
+                    limit = Some((alpha, node, k));
+                }
+            }
+        }
+        let Some((alpha, node, k)) = limit else { return };
+        self.r_free.iter_mut().for_each(|d| *d *= alpha);
+        self.penetration_limits += 1;
+        let tag = self.problem.node_tags.get(node as usize).copied().unwrap_or(node as u64);
+        self.notes.push(format!(
+            "iteration {iteration}: correction shortened to {alpha:.3} of its length: slave node {tag} of pair '{}' would have gone more than {depth} master edge lengths past the master",
+            self.contact[k].name
+        ));
     }
 
     /// Reaction force summed over each constrained node set at the last assembled state.

@@ -34,8 +34,8 @@ pub fn solve_augmented(newton: &mut Newton, lambda: f64, u: &mut [f64], on_itera
     loop {
         let (halvings, searched) = (newton.step_halvings, newton.line_search_steps);
         let solved = newton.solve_increment(lambda, u, on_iteration);
-        for text in std::mem::take(&mut newton.linear_notes) {
-            note(&format!("linear solver: {text}"));
+        for text in std::mem::take(&mut newton.notes) {
+            note(&text);
         }
         let conv = match solved {
             Ok(conv) => conv,

@@ -244,6 +244,13 @@ fn restart_continues_the_run_it_was_cut_from() {
 /// by increment, and reaches the same state (tolerance 1e-9 as above). The
 /// control: with λ_N zeroed the first increment after the cut needs more
 /// augmentations (the multipliers are rebuilt from zero).
+///
+/// Tolerance 1e-8 of max |u| here: the frictional solves are GMRES solves
+/// preconditioned by a factorization the uninterrupted run may have kept from an
+/// earlier iteration, and the inexact Newton stops the last one at what the residual
+/// tolerance (1e-8) asks, so the two converged states agree to that tolerance, not
+/// bit for bit (measured 1.9e-9). A forgotten multiplier leaves the state off by up
+/// to the penetration tolerance (1e-7) until the Uzawa loop rebuilds it.
 #[test]
 fn restart_keeps_the_augmented_lagrangian_multipliers() {
     const CUT: usize = 24;
@@ -256,7 +263,7 @@ fn restart_keeps_the_augmented_lagrangian_multipliers() {
     let aug = |r: &splinecontact::format::scres::Results| r.increments[CUT..].iter().map(|i| i.info.contact[0].augmentations).collect::<Vec<_>>();
     let du = u_difference(&continued, &full, CUT);
     eprintln!("augmented Lagrangian: continued run off by {du:.3e} max |u|; augmentations {:?}, continued {:?}, without λ_N {:?}", aug(&full), aug(&continued), aug(&forgetful));
-    assert!(du <= 1e-9, "continued run differs by {du:e} of max |u|");
+    assert!(du <= 1e-8, "continued run differs by {du:e} of max |u|");
     assert_eq!(aug(&continued), aug(&full));
     assert!(aug(&forgetful)[0] > aug(&full)[0], "the comparison does not see the multipliers");
 }

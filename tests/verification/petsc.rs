@@ -72,15 +72,23 @@ fn krylov_per_solve(log: &str) -> f64 {
 }
 
 /// GAMG on one rank and on two gives the direct solver's answer: both Newton loops
-/// stop at a relative residual of 1e-8 with the same augmented-Lagrangian updates, and
-/// the Krylov solves are converged to 1e-10 at the last iterations (inexact Newton:
-/// η = min(1e-3, 1e-2 r)), so the displacements agree to about 1e-8 of max |u|
-/// (measured 1e-12 on one rank); 1e-6 leaves the round-off of a different
-/// preconditioner room while a wrong dof mapping, a lost constrained row or a rank
-/// that inserted the wrong rows is off by O(1). Newton corrections: equal counts
-/// measured (27 against 26 in the direct run: one more at first contact); ±3 allowed.
-/// Krylov iterations per solve: 25 (1 rank) and 19 (2 ranks) measured; AMG that
-/// lost its near-null space needs 3–5× more, so at most 60.
+/// stop at a relative residual of 1e-8 with the same augmented-Lagrangian updates, so
+/// the displacements agree to about 1e-8 of max |u| (measured 1e-12 on one rank);
+/// 1e-6 leaves the round-off of a different preconditioner room while a wrong dof
+/// mapping, a lost constrained row or a rank that inserted the wrong rows is off by
+/// O(1).
+///
+/// Newton corrections: with every Krylov solve converged (`inexact_newton: false`)
+/// PETSc's tangent solves are the direct solver's, and Newton takes as many
+/// corrections (measured 23 against 24; ±2 allowed: a solve at 1e-10 rather than at
+/// round-off can tip one contact state at a switch). With the inexact Newton's
+/// forcing terms (docs/theory/solver.md, "Inexact Newton") the first solve of each
+/// Newton loop stops at 1e-3, and the contact states can switch an iteration later
+/// than after the faer GMRES solves (4 iterations per solve, each one reducing the
+/// residual by orders of magnitude, so the same η is overshot): measured 28
+/// against 24; at most 1.25× the direct count allowed. Krylov iterations per solve:
+/// 33 (1 rank) measured; AMG that lost its near-null space needs 3–5× more, so at
+/// most 60 (exact solves: 57 measured, at most 90).
 #[test]
 fn gamg_gives_the_direct_answer_on_one_rank_and_on_two() {
     let out = tempfile::tempdir().unwrap();
@@ -96,9 +104,18 @@ fn gamg_gives_the_direct_answer_on_one_rank_and_on_two() {
     assert_eq!(one.status, RunStatus::Completed);
     let d1 = difference(&direct, &one);
     assert!(d1 <= 1e-6, "1 rank: max |Δu| / max |u| = {d1:e}");
-    assert!(corrections(&one).abs_diff(corrections(&direct)) <= 3, "{} against {}", corrections(&one), corrections(&direct));
+    assert!(4 * corrections(&one) <= 5 * corrections(&direct), "{} against {}", corrections(&one), corrections(&direct));
     let k1 = krylov_per_solve(&log);
     assert!(k1 > 1.0 && k1 <= 60.0, "{k1} Krylov iterations per solve");
+    with_linear_solver(&setup, "{method: petsc, inexact_newton: false}", &dir.join("exact.yaml"));
+    let o = solve(&dir, None, "exact.yaml", "exact.scres", &[]);
+    let exact_log = stderr(&o);
+    assert!(o.status.success(), "{exact_log}");
+    let exact = Results::read(&dir.join("exact.scres")).unwrap();
+    assert!(difference(&direct, &exact) <= 1e-6);
+    assert!(corrections(&exact).abs_diff(corrections(&direct)) <= 2, "exact solves: {} against {}", corrections(&exact), corrections(&direct));
+    let k_exact = krylov_per_solve(&exact_log);
+    assert!(k_exact > k1 && k_exact <= 90.0, "{k_exact} Krylov iterations per exact solve");
     // the convergence CSV carries each solve's Krylov iterations: they add up to the
     // log's total
     let csv = std::fs::read_to_string(dir.join("one.convergence.csv")).unwrap();
@@ -119,7 +136,7 @@ fn gamg_gives_the_direct_answer_on_one_rank_and_on_two() {
     let two = Results::read(&dir.join("two.scres")).unwrap();
     let d2 = difference(&one, &two);
     assert!(d2 <= 1e-6, "2 ranks against 1: max |Δu| / max |u| = {d2:e}");
-    assert!(corrections(&two).abs_diff(corrections(&one)) <= 3);
+    assert!(4 * corrections(&two) <= 5 * corrections(&direct), "2 ranks: {} against {}", corrections(&two), corrections(&direct));
     let k2 = krylov_per_solve(&log);
     assert!(k2 > 1.0 && k2 <= 60.0, "{k2} Krylov iterations per solve on 2 ranks");
     // both wrote the same model: the friction history of the last increment agrees
