@@ -85,7 +85,21 @@ def main():
     ap.add_argument("--out", default=str(ROOT / "pipelines" / "out" / "petsc_scaling"))
     ap.add_argument("--skip", action="append", default=[], choices=sorted(VARIANTS))
     ap.add_argument("--plot", default=None)
+    ap.add_argument("--add", default=None, metavar="JSON",
+                    help="rows run by hand (e.g. level 22 under mpirun), {variant: [row, ...]} in the script's "
+                         "row format, added to the table and the plot")
+    ap.add_argument("--replot", default=None, metavar="JSON",
+                    help="do not run: read a scaling.json written before (plus --add) and print and plot it")
     a = ap.parse_args()
+    if a.replot:
+        results = json.loads(Path(a.replot).read_text())
+        if a.add:
+            for name, rows in json.loads(Path(a.add).read_text()).items():
+                results.setdefault(name, []).extend(rows)
+        print(table(results))
+        if a.plot:
+            plot(results, a.plot)
+        return
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     results = {}
@@ -96,6 +110,9 @@ def main():
         results[name] = run_variant(name, levels, out)
         print("%s done" % name, file=sys.stderr)
     (out / "scaling.json").write_text(json.dumps(results, indent=1) + "\n")
+    if a.add:
+        for name, rows in json.loads(Path(a.add).read_text()).items():
+            results.setdefault(name, []).extend(rows)
     print(table(results))
     if a.plot:
         plot(results, a.plot)
