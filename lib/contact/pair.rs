@@ -127,11 +127,96 @@ impl Projector {
     }
 }
 
+/// The closest-point projection of one slave at `xs` (the body of
+/// [`PairSolver::search`]): its projection, surface point and facet cell.
+fn project_slave(projector: &Projector, frozen: bool, edge_tolerance: f64, xs: &Vec3, proj: &mut Projection, sp: &mut SurfacePoint, cell: &mut Option<[usize; 2]>) {
+    let (pr, c) = if frozen { projector.project_frozen(xs, *cell, proj) } else { projector.project(xs, *cell) };
+    *proj = pr;
+    *cell = c;
+    if proj.converged {
+        *sp = projector.evaluate(proj.xi, c);
+    }
+    // Beyond the edge by less than the edge tolerance (a slave edge flush with the
+    // master's): project onto the surface's extension, where the closest-point
+    // conditions hold, and keep the node in contact.
+    if proj.converged && !proj.inside {
+        let d = xs - proj.x_bar;
+        let overhang = if proj.clamped.iter().any(|&c| c) {
+            // on a crease the distance vector also leans across it: measure only
+            // along the directions held on the patch edge
+            (0..2).filter(|&al| proj.xi[al] <= 0.0 || proj.xi[al] >= 1.0).map(|al| d.dot(&sp.a_alpha[al]).abs() / sp.a_alpha[al].norm()).fold(0.0, f64::max)
+        } else {
+            (d - sp.n_bar * d.dot(&sp.n_bar)).norm()
+        };
+        if overhang <= edge_tolerance {
+            let margin = [0, 1].map(|al| 2.0 * edge_tolerance / sp.a_alpha[al].norm().max(1e-300));
+            let ext = projector.project_extended(xs, proj.xi, c, margin);
+            if ext.converged {
+                *proj = Projection { inside: true, ..ext };
+                *sp = projector.evaluate(proj.xi, c);
+            }
+        }
+    }
+    if proj.converged {
+        sp.hold_on_crease(xs, proj.clamped);
+    }
+}
+
 /// A pair that cannot be set up.
 #[derive(Debug, thiserror::Error)]
 pub enum PairError {
     #[error("contact pair '{pair}': master surface: {source}")]
     Master { pair: String, source: SplineError },
+    #[error("contact pair '{pair}': exchanging the search results between MPI ranks: {message}")]
+    Exchange { pair: String, message: String },
+}
+
+/// A search shared by several MPI ranks ([`PairSolver::search_shared`]): each
+/// projects the slave nodes `mine` says are its own, and `exchange` sums a buffer
+/// over the ranks (every rank passes the same length).
+pub struct SearchShare<'a> {
+    pub mine: &'a (dyn Fn(u32) -> bool + Sync),
+    pub exchange: &'a mut dyn FnMut(&mut [f64]) -> Result<(), String>,
+}
+
+/// Numbers per slave in the buffer a shared search exchanges.
+const PACKED: usize = 14;
+
+/// A slave's search result as numbers, for the exchange between ranks (exact: the
+/// other ranks add zeros).
+fn pack(p: &Projection, cell: Option<[usize; 2]>, out: &mut [f64]) {
+    let b = |v: bool| f64::from(u8::from(v));
+    let [c0, c1] = cell.unwrap_or([0, 0]);
+    out.copy_from_slice(&[
+        p.xi[0],
+        p.xi[1],
+        p.x_bar.x,
+        p.x_bar.y,
+        p.x_bar.z,
+        p.g,
+        b(p.inside),
+        p.iterations as f64,
+        b(p.converged),
+        b(p.clamped[0]),
+        b(p.clamped[1]),
+        b(cell.is_some()),
+        c0 as f64,
+        c1 as f64,
+    ]);
+}
+
+/// The inverse of [`pack`].
+fn unpack(v: &[f64]) -> (Projection, Option<[usize; 2]>) {
+    let p = Projection {
+        xi: [v[0], v[1]],
+        x_bar: Vec3::new(v[2], v[3], v[4]),
+        g: v[5],
+        inside: v[6] != 0.0,
+        iterations: v[7] as usize,
+        converged: v[8] != 0.0,
+        clamped: [v[9] != 0.0, v[10] != 0.0],
+    };
+    (p, (v[11] != 0.0).then_some([v[12] as usize, v[13] as usize]))
 }
 
 /// The state of one pair.
@@ -188,6 +273,8 @@ pub struct PairSolver {
     pub t_t_vector: Vec<Vec3>,
     pub slipping: Vec<bool>,
     pub slave_force: Vec<Vec3>,
+    /// The buffer of a shared search (storage reused).
+    exchange: Vec<f64>,
 }
 
 /// A snapshot of the multipliers an Uzawa update sets ([`PairSolver::multipliers`]).
@@ -263,11 +350,21 @@ impl PairSolver {
             t_t_vector: vec![Vec3::zeros(); n],
             slipping: vec![false; n],
             slave_force: vec![Vec3::zeros(); n],
+            exchange: Vec::new(),
         })
     }
 
     /// Closest-point search at the current positions `x(node)` of all nodes.
     pub fn search(&mut self, x: impl Fn(u32) -> Vec3 + Sync) -> Result<(), PairError> {
+        self.search_shared(x, None)
+    }
+
+    /// [`Self::search`], shared by several MPI ranks when `share` is given: each rank
+    /// projects only its own slave nodes, and the ranks exchange the results, so
+    /// every rank ends with every slave's projection (bit for bit the one a single
+    /// rank computes: the master surface is the same on all, and a projection
+    /// depends only on it, on the slave's position and on the slave's last result).
+    pub fn search_shared(&mut self, x: impl Fn(u32) -> Vec3 + Sync, share: Option<SearchShare<'_>>) -> Result<(), PairError> {
         for (xn, &node) in self.x_net.iter_mut().zip(&self.net) {
             *xn = x(node);
         }
@@ -276,44 +373,49 @@ impl PairSolver {
         let edge_tolerance = self.edge_tolerance;
         let frozen = self.frozen;
         self.x_slave.iter_mut().zip(&self.slaves).for_each(|(xs, &node)| *xs = x(node));
+        let mine = share.as_ref().map(|s| s.mine);
+        let is_mine = |node: u32| mine.is_none_or(|m| m(node));
         self.projections
             .par_iter_mut()
             .zip(self.points.par_iter_mut())
             .zip(self.cells.par_iter_mut())
             .zip(self.x_slave.par_iter())
+            .zip(self.slaves.par_iter())
             .with_min_len(64)
-            .for_each(|(((proj, sp), cell), xs)| {
-                let (pr, c) = if frozen { projector.project_frozen(xs, *cell, proj) } else { projector.project(xs, *cell) };
-                *proj = pr;
-                *cell = c;
-                if proj.converged {
-                    *sp = projector.evaluate(proj.xi, c);
-                }
-                // Beyond the edge by less than the edge tolerance (a slave edge flush
-                // with the master's): project onto the surface's extension, where the
-                // closest-point conditions hold, and keep the node in contact.
-                if proj.converged && !proj.inside {
-                    let d = xs - proj.x_bar;
-                    let overhang = if proj.clamped.iter().any(|&c| c) {
-                        // on a crease the distance vector also leans across it: measure
-                        // only along the directions held on the patch edge
-                        (0..2).filter(|&al| proj.xi[al] <= 0.0 || proj.xi[al] >= 1.0).map(|al| d.dot(&sp.a_alpha[al]).abs() / sp.a_alpha[al].norm()).fold(0.0, f64::max)
-                    } else {
-                        (d - sp.n_bar * d.dot(&sp.n_bar)).norm()
-                    };
-                    if overhang <= edge_tolerance {
-                        let margin = [0, 1].map(|al| 2.0 * edge_tolerance / sp.a_alpha[al].norm().max(1e-300));
-                        let ext = projector.project_extended(xs, proj.xi, c, margin);
-                        if ext.converged {
-                            *proj = Projection { inside: true, ..ext };
-                            *sp = projector.evaluate(proj.xi, c);
-                        }
-                    }
-                }
-                if proj.converged {
-                    sp.hold_on_crease(xs, proj.clamped);
+            .for_each(|((((proj, sp), cell), xs), &node)| {
+                if is_mine(node) {
+                    project_slave(projector, frozen, edge_tolerance, xs, proj, sp, cell);
                 }
             });
+        if let Some(share) = share {
+            let n = self.slaves.len();
+            self.exchange.clear();
+            self.exchange.resize(PACKED * n, 0.0);
+            for s in (0..n).filter(|&s| is_mine(self.slaves[s])) {
+                pack(&self.projections[s], self.cells[s], &mut self.exchange[PACKED * s..PACKED * (s + 1)]);
+            }
+            (share.exchange)(&mut self.exchange).map_err(|message| PairError::Exchange { pair: self.name.clone(), message })?;
+            let exchange = &self.exchange;
+            self.projections
+                .par_iter_mut()
+                .zip(self.points.par_iter_mut())
+                .zip(self.cells.par_iter_mut())
+                .zip(self.x_slave.par_iter())
+                .zip(self.slaves.par_iter())
+                .enumerate()
+                .with_min_len(64)
+                .for_each(|(s, ((((proj, sp), cell), xs), &node))| {
+                    if is_mine(node) {
+                        return;
+                    }
+                    (*proj, *cell) = unpack(&exchange[PACKED * s..PACKED * (s + 1)]);
+                    if proj.converged {
+                        // what the owner's search left in its surface point
+                        *sp = projector.evaluate(proj.xi, *cell);
+                        sp.hold_on_crease(xs, proj.clamped);
+                    }
+                });
+        }
         for s in 0..self.slaves.len() {
             if self.xi_n[s][0].is_nan() && self.usable(s) {
                 self.xi_n[s] = self.projections[s].xi;
@@ -675,7 +777,86 @@ impl PairSolver {
 
 #[cfg(test)]
 mod tests {
-    use super::Multipliers;
+    use super::*;
+    use crate::contact::net::ControlNet;
+    use crate::format::sccontact::{ContactPair, SlaveKind};
+
+    /// A wavy 6 × 5 master net (nodes 0..30) and 40 slave nodes over it and beyond
+    /// its edges (nodes 30..70): positions and the pair.
+    fn wavy_pair(kind: MasterKind) -> (Vec<Vec3>, PairSolver) {
+        let (a, b) = (6, 5);
+        let mut x: Vec<Vec3> = Vec::new();
+        for j in 0..b {
+            for i in 0..a {
+                let (u, v) = (i as f64 / (a - 1) as f64, j as f64 / (b - 1) as f64);
+                x.push(Vec3::new(u, v, 0.1 * (3.0 * u).sin() * (2.0 * v).cos()));
+            }
+        }
+        let mut rng = crate::fem::fd::Lcg(11);
+        for _ in 0..40 {
+            // uniform() is in [−1, 1): x, y in [−0.1, 1.1), z in [−0.05, 0.15)
+            x.push(Vec3::new(0.5 + 0.6 * rng.uniform(), 0.5 + 0.6 * rng.uniform(), 0.05 + 0.1 * rng.uniform()));
+        }
+        let pair = ContactPair {
+            name: "c".into(),
+            slave_kind: SlaveKind::NodeSet,
+            slave: "s".into(),
+            master: "m".into(),
+            master_kind: kind,
+            orders: if kind == MasterKind::Facet { [2, 2] } else { [3, 3] },
+            slave_nodes: (30..70).collect(),
+            net: ControlNet { a, b, nodes: (0..30).collect() },
+        };
+        let settings = PairSettings { eps_n: 1e3, enforcement: Enforcement::Penalty, penetration_tolerance: 1e-3, max_augmentations: 0, update_halvings: 0, mu: 0.0, eps_t: 0.0, stabilization: 0.0 };
+        let def = ContactDefinition { pair, settings, areas: vec![0.01; 40], h_master: 0.2, eps_n_default: false };
+        let solver = PairSolver::new(&def, &x).unwrap();
+        (x, solver)
+    }
+
+    #[test]
+    fn a_search_shared_by_two_ranks_gives_every_rank_the_single_search_bit_for_bit() {
+        for kind in [MasterKind::Bspline, MasterKind::Facet] {
+            let (x, mut whole) = wavy_pair(kind);
+            let (_, mut rank_a) = wavy_pair(kind);
+            let (_, mut rank_b) = wavy_pair(kind);
+            let at = |n: u32| x[n as usize];
+            whole.search(at).unwrap();
+            // rank b searches the odd slave nodes and keeps what it would send
+            let odd = |n: u32| n % 2 == 1;
+            let even = |n: u32| n % 2 == 0;
+            let mut sent = Vec::new();
+            let mut keep = |buffer: &mut [f64]| {
+                sent = buffer.to_vec();
+                Ok(())
+            };
+            rank_b.search_shared(at, Some(SearchShare { mine: &odd, exchange: &mut keep })).unwrap();
+            // rank a searches the even ones and receives the sum
+            let mut add = |buffer: &mut [f64]| {
+                buffer.iter_mut().zip(&sent).for_each(|(v, w)| *v += w);
+                Ok(())
+            };
+            rank_a.search_shared(at, Some(SearchShare { mine: &even, exchange: &mut add })).unwrap();
+            let inside = (0..40).filter(|&s| whole.usable(s)).count();
+            assert!(inside > 10 && inside < 40, "{kind:?}: {inside} slaves on the patch: the test needs both kinds");
+            for s in 0..40 {
+                let (p, q) = (&whole.projections[s], &rank_a.projections[s]);
+                assert_eq!((p.xi.map(f64::to_bits), p.g.to_bits(), p.inside, p.converged, p.clamped), (q.xi.map(f64::to_bits), q.g.to_bits(), q.inside, q.converged, q.clamped), "{kind:?} slave {s}");
+                assert_eq!(whole.cells[s], rank_a.cells[s]);
+                if whole.usable(s) {
+                    assert_eq!(whole.points[s], rank_a.points[s], "{kind:?} slave {s}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn an_exchange_failure_names_the_pair() {
+        let (x, mut pair) = wavy_pair(MasterKind::Bspline);
+        let mine = |n: u32| n < 50;
+        let mut fail = |_: &mut [f64]| Err("MPI_Allreduce failed".to_string());
+        let e = pair.search_shared(|n| x[n as usize], Some(SearchShare { mine: &mine, exchange: &mut fail })).unwrap_err().to_string();
+        assert!(e.contains("'c'") && e.contains("MPI_Allreduce failed"), "{e}");
+    }
 
     #[test]
     fn damped_update_lies_between_the_iterates() {

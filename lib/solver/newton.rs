@@ -21,7 +21,7 @@ use super::ranks;
 use super::stabilization::Stabilization;
 use crate::assembly::{Assembly, AssemblyError, ElementFailure, NodeGroups, Pattern, PatternError, DOFS_PER_NODE};
 use crate::contact::element::ContactElementError;
-use crate::contact::pair::{PairError, PairSolver};
+use crate::contact::pair::{PairError, PairSolver, SearchShare};
 use crate::fem::element::{hex8_gauss_stresses, hex8_residual_tangent, ElementError};
 use crate::fem::pressure::{follower_pressure_force_stiffness, FaceMatrix, FaceVector};
 use crate::format::scres::{Increment, IterationLog};
@@ -199,7 +199,7 @@ impl<'p> Newton<'p> {
         // several ranks share the work (only the PETSc backend can: checked above)
         let partition = (ranks > 1).then(|| Partition::new(problem));
         let (mut owners, mut groups) = (Vec::new(), NodeGroups::new());
-        contact_groups(problem, &mut contact, &vec![0.0; DOFS_PER_NODE * problem.n_nodes()], &mut groups, &mut owners)?;
+        contact_groups(problem, &mut contact, &vec![0.0; DOFS_PER_NODE * problem.n_nodes()], &mut groups, &mut owners, partition.as_ref())?;
         if let Some(part) = &partition {
             part.keep_local_groups(&mut groups, &mut owners);
         }
@@ -284,7 +284,7 @@ impl<'p> Newton<'p> {
         }
         let fail = |message: String| IncrementFailure::ContactSetup { iteration, message };
         let mut groups = std::mem::take(&mut self.group_scratch);
-        contact_groups(self.problem, &mut self.contact, u, &mut groups, &mut self.owners).map_err(|e| fail(e.to_string()))?;
+        contact_groups(self.problem, &mut self.contact, u, &mut groups, &mut self.owners, self.partition.as_ref()).map_err(|e| fail(e.to_string()))?;
         if let Some(part) = &self.partition {
             part.keep_local_groups(&mut groups, &mut self.owners);
         }
@@ -795,7 +795,9 @@ impl Partition {
 /// Contact search of every pair at `u` and the node groups of the pattern into
 /// `groups`: the follower-pressure faces, then every contact element; `owners` says
 /// which is which. (Both keep their storage between calls.)
-fn contact_groups(p: &Problem, contact: &mut [PairSolver], u: &[f64], groups: &mut NodeGroups, owners: &mut Vec<GroupOwner>) -> Result<(), PairError> {
+/// With several MPI ranks (`partition`), each rank projects the slave nodes it owns
+/// and the ranks exchange the results ([`PairSolver::search_shared`]).
+fn contact_groups(p: &Problem, contact: &mut [PairSolver], u: &[f64], groups: &mut NodeGroups, owners: &mut Vec<GroupOwner>, partition: Option<&Partition>) -> Result<(), PairError> {
     groups.clear();
     for f in &p.pressure_faces {
         groups.push(&f.nodes);
@@ -803,10 +805,18 @@ fn contact_groups(p: &Problem, contact: &mut [PairSolver], u: &[f64], groups: &m
     owners.clear();
     owners.extend((0..p.pressure_faces.len()).map(GroupOwner::Pressure));
     for (k, pair) in contact.iter_mut().enumerate() {
-        pair.search(|n| {
+        let x = |n: u32| {
             let d = DOFS_PER_NODE * n as usize;
             p.X[n as usize] + Vector3::new(u[d], u[d + 1], u[d + 2])
-        })?;
+        };
+        match partition {
+            None => pair.search(x)?,
+            Some(part) => {
+                let mine = |n: u32| (n as usize) >= part.first && (n as usize) < part.last;
+                let mut exchange = |buffer: &mut [f64]| ranks::reduce_over_ranks(buffer, ranks::Reduction::Sum);
+                pair.search_shared(x, Some(SearchShare { mine: &mine, exchange: &mut exchange }))?;
+            }
+        }
         pair.push_groups(groups, |s| owners.push(GroupOwner::Contact(k, s)));
     }
     Ok(())

@@ -76,7 +76,7 @@ pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, 
     let (rank, ranks) = crate::solver::ranks::rank_and_size();
     let mut log = SolveLog::new(if rank > 0 { Verbosity::Silent } else { verbosity }, factors.len());
     if ranks > 1 {
-        log.line(&format!("MPI: {ranks} ranks; each owns a contiguous range of nodes, assembles the elements and contact elements that touch them and inserts their rows; rank 0 writes the results and this log"));
+        log.line(&format!("MPI: {ranks} ranks; each owns a contiguous range of nodes, projects the slave nodes among them onto the master (the results are exchanged), assembles the elements and contact elements that touch them and inserts their rows; rank 0 writes the results and this log"));
     }
     for (c, def) in newton.contact.iter().zip(&problem.contact) {
         let s = &c.settings;
