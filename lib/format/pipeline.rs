@@ -52,6 +52,8 @@ pub enum Stage {
     Gmsh(GmshStage),
     Import(ImportStage),
     Tag(TagStage),
+    /// The pre-solve check of a model and its setup (`sc-check`).
+    Check(CheckStage),
     Solve(SolveStage),
     Export(ExportStage),
     /// Force-history CSVs → a PNG line plot; the keys are [`PlotSpec`]'s.
@@ -64,6 +66,7 @@ impl Stage {
             Self::Gmsh(_) => "gmsh",
             Self::Import(_) => "import",
             Self::Tag(_) => "tag",
+            Self::Check(_) => "check",
             Self::Solve(_) => "solve",
             Self::Export(_) => "export",
             Self::Plot(_) => "plot",
@@ -122,6 +125,31 @@ pub struct SolveStage {
     /// `sc-solve --restart-increment`).
     #[serde(default)]
     pub restart_increment: Option<usize>,
+}
+
+/// Check: a model and a solve setup → the pre-solve check (`sc-check`); the setup
+/// inline (`setup:`, e.g. a YAML alias of the solve stage's) or in a file.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CheckStage {
+    pub input: PathBuf,
+    #[serde(default)]
+    pub setup: Option<SolveSetup>,
+    #[serde(default)]
+    pub setup_file: Option<PathBuf>,
+    /// Write `<output>.csv`, `<output>.vtu` and `<output>.txt`.
+    #[serde(default)]
+    pub output: Option<PathBuf>,
+    /// Or each on its own (these win over `output`).
+    #[serde(default)]
+    pub csv: Option<PathBuf>,
+    #[serde(default)]
+    pub vtu: Option<PathBuf>,
+    #[serde(default)]
+    pub summary: Option<PathBuf>,
+    /// Fail the stage (and the pipeline) on what the solve refuses (a flipped master).
+    #[serde(default)]
+    pub strict: bool,
 }
 
 #[derive(Debug, Deserialize)]
