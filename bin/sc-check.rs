@@ -25,6 +25,7 @@ use splinecontact::stages::exit_code;
 ///   - what `adjust: <distance>` in the pair's contact entry would move: slave
 ///     nodes with |g_N| ≤ distance put onto the master, stress-free, before the
 ///     first increment (Abaqus ADJUST, ANSYS ICONT).
+///
 /// Per body (connected part of the mesh): the rigid-body modes no constraint holds
 /// ("translation x", "rotation about z", ...). A body held only by contact is
 /// legitimate, but needs contact at the start (zero gap) and, frictionless, supports

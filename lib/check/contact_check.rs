@@ -234,9 +234,19 @@ impl PairCheck {
     }
 }
 
+/// A slave node's projection as the check reads it.
+#[derive(Debug, Clone, Copy)]
+struct Foot {
+    projected: Projected,
+    g_n: f64,
+    xi: [f64; 2],
+    n_bar: V3,
+    x_bar: V3,
+}
+
 /// The projections of one pair's slave nodes at the coordinates `X`, as the solve's
-/// search makes them: (projected, g_N, ξ̄, n̄, x̄) per slave node.
-fn project(def: &ContactDefinition, X: &[V3]) -> Result<(PairSolver, Vec<(Projected, f64, [f64; 2], V3, V3)>), PairError> {
+/// search makes them.
+fn project(def: &ContactDefinition, X: &[V3]) -> Result<(PairSolver, Vec<Foot>), PairError> {
     let mut solver = PairSolver::new(def, X)?;
     solver.search(|n| X[n as usize])?;
     let out = (0..solver.slaves.len())
@@ -253,7 +263,7 @@ fn project(def: &ContactDefinition, X: &[V3]) -> Result<(PairSolver, Vec<(Projec
                 Projected::Outside
             };
             let n_bar = if p.converged && n_ok { sp.n_bar } else { V3::from_element(f64::NAN) };
-            (projected, p.g, p.xi, n_bar, p.x_bar)
+            Foot { projected, g_n: p.g, xi: p.xi, n_bar, x_bar: p.x_bar }
         })
         .collect();
     Ok((solver, out))
@@ -276,7 +286,7 @@ pub fn check_pair(mesh: &Mesh, def: &ContactDefinition, X_solve: &[V3], adjustme
     orientation.cells_inward = cells_inward;
     let mut rows = Vec::with_capacity(pair.slave_nodes.len());
     for (s, &node) in pair.slave_nodes.iter().enumerate() {
-        let (projected, g_n, xi, n_bar, x_bar) = proj[s];
+        let Foot { projected, g_n, xi, n_bar, x_bar } = proj[s];
         let vote = if projected == Projected::Inside { behind(&interior[s], &x_bar, &n_bar) } else { None };
         if let Some(b) = vote {
             orientation.voters += 1;
@@ -294,7 +304,7 @@ pub fn check_pair(mesh: &Mesh, def: &ContactDefinition, X_solve: &[V3], adjustme
             penetrating: projected == Projected::Inside && -g_n > tol,
             behind: vote,
             adjust_move,
-            g_n_adjusted: after.as_ref().map_or(g_n, |a| a[s].1),
+            g_n_adjusted: after.as_ref().map_or(g_n, |a| a[s].g_n),
         });
     }
     let slave = match pair.slave_kind {

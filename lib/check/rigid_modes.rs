@@ -231,13 +231,12 @@ pub fn null_space(g: &Matrix6<f64>) -> Vec<FreeMode> {
         for v in basis[row].iter_mut() {
             *v /= pivot;
         }
-        for r in 0..basis.len() {
-            if r != row {
-                let f = basis[r][col];
-                if f != 0.0 {
-                    for j in 0..6 {
-                        basis[r][j] -= f * basis[row][j];
-                    }
+        let pivot_row = basis[row];
+        for (r, q) in basis.iter_mut().enumerate() {
+            let f = q[col];
+            if r != row && f != 0.0 {
+                for (v, p) in q.iter_mut().zip(&pivot_row) {
+                    *v -= f * p;
                 }
             }
         }

@@ -79,7 +79,7 @@ pub fn adjust_pair(def: &ContactDefinition, distance: f64, X: &mut [Vector3<f64>
     let mut moved = Vec::new();
     for (s, &node) in solver.slaves.iter().enumerate() {
         let (proj, point) = solver.foot(s);
-        if !solver.usable(s) || !(proj.g.abs() <= distance) || proj.g == 0.0 {
+        if !solver.usable(s) || proj.g.is_nan() || proj.g.abs() > distance || proj.g == 0.0 {
             continue;
         }
         // x_s − x̄ = g_N n̄ at the closest point (eq. 4.3): the foot point is X_s − g_N n̄
@@ -89,7 +89,7 @@ pub fn adjust_pair(def: &ContactDefinition, distance: f64, X: &mut [Vector3<f64>
     }
     let before: Vec<Vector3<f64>> = moved.iter().map(|m| X[m.node as usize]).collect();
     for m in &moved {
-        X[m.node as usize] = X[m.node as usize] + m.displacement;
+        X[m.node as usize] += m.displacement;
     }
     if !moved.is_empty() {
         let touched: std::collections::HashSet<u32> = moved.iter().map(|m| m.node).collect();
