@@ -280,3 +280,32 @@ fn parisch_pipeline_checks_clean() {
     assert_eq!(rows.len(), 9);
     assert!(rows.iter().all(|r| r.flag == "ok" && r.g_n.abs() < 1e-12), "every slave node touches its master");
 }
+
+/// The check of a model with a million dofs (two blocks, 351,645 nodes, 8,464 slave
+/// nodes on a 91 × 91 master net) takes well under a second (0.17 s on the 2-core
+/// reference machine, docs/diagnosing.md); the bound leaves room for a slow machine.
+/// `cargo test --release --test tests check_of_a_million_dofs -- --nocapture`
+#[test]
+fn check_of_a_million_dofs_takes_seconds() {
+    use splinecontact::format::setup::SolveSetup;
+    use splinecontact::solver::problem::Problem;
+    let lower = block([90, 90, 20], [1.0, 1.0, 0.5], 0.0);
+    let upper = block([91, 91, 20], [1.0, 1.0, 0.5], 0.0);
+    let mesh = two_bodies("lower", &lower, "upper", &upper, [0.0, 0.0, 0.5]);
+    let spec = PairSpec { name: "c".into(), slave: "upper_z0".into(), master: "lower_z1".into(), master_kind: MasterKind::Bspline, orders: Some([3, 3]) };
+    let model = build_model(mesh, "big", &[spec]).unwrap();
+    let setup = SolveSetup::parse("s", &setup("enforcement: penalty, adjust: 1.0e-6", false, 1e-3)).unwrap();
+    let start = std::time::Instant::now();
+    let problem = Problem::with_contact(&model.mesh, &model.pairs, &setup, "s").unwrap();
+    let built = start.elapsed().as_secs_f64();
+    let r = splinecontact::check::run(&model.mesh, &problem, "big", "s").unwrap();
+    let total = start.elapsed().as_secs_f64();
+    let dir = tempdir();
+    let t = std::time::Instant::now();
+    splinecontact::check::report::write_csv(&r, &dir.path().join("c.csv")).unwrap();
+    splinecontact::check::report::write_vtu(&r, &dir.path().join("c.vtu")).unwrap();
+    let written = t.elapsed().as_secs_f64();
+    eprintln!("{} dofs, {} slave nodes: problem (with adjust) {built:.2} s, check {:.2} s, total {total:.2} s; CSV + vtu {written:.2} s", r.dofs, r.pairs[0].rows.len(), r.seconds);
+    assert!(r.dofs > 1_000_000 && r.errors().is_empty());
+    assert!(total < 10.0, "the check took {total:.1} s");
+}
