@@ -268,6 +268,20 @@ stages:
     }
 
     #[test]
+    fn check_stage_shares_the_solve_setup_by_an_alias() {
+        let y = "version: 1\nstages:\n  - check:\n      input: m.sccontact\n      output: out/m-check\n      strict: true\n      setup: &s\n        materials: [{body: b, model: linear_elastic, E: 1.0, nu: 0.3}]\n        contact: [{pair: c, adjust: 1.0e-3, allow_flipped_master: true}]\n  - solve: {input: m.sccontact, output: m.scres, setup: *s}\n";
+        let p = Pipeline::parse("p.yaml", y).unwrap();
+        let (Stage::Check(c), Stage::Solve(s)) = (&p.stages[0], &p.stages[1]) else { panic!("not check, solve") };
+        assert!(c.strict && c.output.as_deref() == Some(Path::new("out/m-check")));
+        let (a, b) = (c.setup.as_ref().unwrap(), s.setup.as_ref().unwrap());
+        assert_eq!((a.contact[0].adjust, a.contact[0].allow_flipped_master), (Some(1e-3), true));
+        assert_eq!(serde_yaml::to_string(a).unwrap(), serde_yaml::to_string(b).unwrap());
+        let bad = y.replace("strict: true", "stict: true");
+        let e = Pipeline::parse("p.yaml", &bad).unwrap_err().to_string();
+        assert!(e.contains("stict") && e.contains("line 6"), "{e}");
+    }
+
+    #[test]
     fn newer_version_is_refused() {
         let e = Pipeline::parse("p.yaml", "version: 2\nstages: []\n").unwrap_err().to_string();
         assert!(e.contains("version 2"), "{e}");

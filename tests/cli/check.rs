@@ -225,6 +225,42 @@ fn initial_overlap_is_reported_and_adjusted() {
     assert_eq!(Results::read(&d.join("plain.scres")).unwrap().mesh.nodes, mesh.nodes);
 }
 
+/// An adjust that would lift a slave node past the next layer of its own body (two
+/// layers of the upper block overlap the master) is refused, naming node and element;
+/// a strict check stage in a pipeline stops the pipeline on a flipped master.
+#[test]
+fn adjust_that_inverts_an_element_and_strict_stage_fail() {
+    let dir = tempdir();
+    let d = dir.path();
+    let mut mesh = stacked(|_| 0.3);
+    // the upper block's second layer (z = 0.75) down to 0.45, below the master
+    for p in mesh.nodes.iter_mut() {
+        if (p[2] - 0.75).abs() < 1e-12 {
+            p[2] = 0.45;
+        }
+    }
+    write_model(d, &mesh, "lower_z1", false);
+    std::fs::write(d.join("s.yaml"), setup("enforcement: penalty, adjust: 0.5", false, 0.0)).unwrap();
+    let o = run("sc-check", &["m.sccontact", "--setup", "s.yaml"], d);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("contact pair 'c': adjust 5e-1 moves slave node") && err.contains("by 3.0000e-1 onto the master, which inverts hexahedron") && err.contains("give a smaller adjust"), "{err}");
+    let o = run("sc-solve", &["m.sccontact", "--setup", "s.yaml", "-o", "r.scres"], d);
+    crate::common::assert_fails(&o, 2, &["which inverts hexahedron"], &d.join("r.scres"));
+
+    write_model(d, &stacked(|_| 0.0), "lower_z1", true);
+    let yaml = format!(
+        "version: 1\nstages:\n  - check:\n      input: m.sccontact\n      output: out/chk\n      strict: true\n      setup: &s\n{}  - solve: {{input: m.sccontact, output: r.scres, setup: *s}}\n",
+        setup("enforcement: penalty", false, 0.001).lines().map(|l| format!("        {l}\n")).collect::<String>()
+    );
+    std::fs::write(d.join("p.yaml"), yaml).unwrap();
+    let o = run("sc-pipeline", &["p.yaml"], d);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("stage 1 (check) failed") && err.contains("a flipped master"), "{err}");
+    assert!(d.join("out/chk.csv").is_file() && !d.join("r.scres").exists(), "the check wrote its files, the solve did not run");
+}
+
 /// A block held only by contact: its top is moved down in z and nothing else holds
 /// it. The check names exactly the modes contact must hold (frictionless: none of
 /// them) and the solve warns about them at its start.
