@@ -215,6 +215,13 @@ fn initial_overlap_is_reported_and_adjusted() {
             assert_eq!(p, q, "node {n} is no slave and must not move");
         }
     }
+    // a restart of the adjusted run (a longer load path) adjusts the same nodes the
+    // same way, so the results file is recognised as the same model
+    std::fs::write(d.join("longer.yaml"), setup(&format!("{tol}, adjust: 5.0e-3"), false, 1e-3).replace("increments: {count: 1,", "increments: {count: 2, end: 2.0,")).unwrap();
+    let o = run("sc-solve", &["m.sccontact", "--setup", "longer.yaml", "-o", "r.scres", "--restart", "r.scres", "-q"], d);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let longer = Results::read(&d.join("r.scres")).unwrap();
+    assert_eq!((longer.increments.len(), &longer.mesh.nodes), (2, &r.mesh.nodes));
     // and they start touching: the check of the adjusted setup sees |g_N| ≤ 1e-12
     let o = run("sc-check", &["m.sccontact", "--setup", "all.yaml", "--csv", "all.csv"], d);
     assert!(o.status.success());
