@@ -194,6 +194,11 @@ fn initial_overlap_is_reported_and_adjusted() {
         }
     }
     assert_eq!(rows.iter().filter(|r| r.adjust_move > 0.0).count(), 8);
+    let o = run("sc-check", &["m.sccontact", "--setup", "a.yaml", "-q", "--vtu", "a.vtu", "--csv", "a.csv"], d);
+    assert!(o.status.success() && o.stdout.is_empty(), "-q prints no summary");
+    let o = crate::common::python_script("check_presolve_vtu.py", &[&d.join("a.vtu"), &d.join("a.csv")]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("\"flags\": [\"adjusted\", \"penetrating\"]"), "{}", String::from_utf8_lossy(&o.stdout));
     // the check moved nothing on disk
     let o = run("sc-check", &["m.sccontact", "--setup", "s.yaml", "--csv", "s2.csv"], d);
     assert!(o.status.success());
@@ -322,6 +327,10 @@ fn parisch_pipeline_checks_clean() {
     let rows = read_csv(&dir.path().join("pipelines/out/parisch-check.csv"));
     assert_eq!(rows.len(), 9);
     assert!(rows.iter().all(|r| r.flag == "ok" && r.g_n.abs() < 1e-12), "every slave node touches its master");
+    let out = dir.path().join("pipelines/out");
+    let o = crate::common::python_script("check_presolve_vtu.py", &[&out.join("parisch-check.vtu"), &out.join("parisch-check.csv")]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("\"points\": 9"), "{}", String::from_utf8_lossy(&o.stdout));
 }
 
 /// The check of a model with a million dofs (two blocks, 351,645 nodes, 8,464 slave
