@@ -65,6 +65,11 @@ pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, 
     }
     let start = Instant::now();
     let (mut mesh, pairs) = read_model(input)?;
+    // A restart file of another model is named before the setup is checked against
+    // this one; with `adjust` the file holds the adjusted coordinates, so it is
+    // compared with them, once the problem has moved the nodes.
+    let adjusts = setup.contact.iter().any(|c| c.adjust.is_some_and(|d| d != 0.0));
+    let mut point = if adjusts { None } else { restart.map(|r| RestartPoint::read(r.file, r.increment, &mesh, &pairs)).transpose()? };
     let problem = Problem::with_contact(&mesh, &pairs, setup, setup_name)?;
     // the pre-solve check: a flipped master stops here; free rigid modes are warned about
     let check = crate::check::run(&mesh, &problem, &input.display().to_string(), setup_name)?;
@@ -75,7 +80,9 @@ pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, 
         // the adjusted reference coordinates are the model's from here on (results, restart)
         mesh.nodes = problem.X.iter().map(|x| [x[0], x[1], x[2]]).collect();
     }
-    let point = restart.map(|r| RestartPoint::read(r.file, r.increment, &mesh, &pairs)).transpose()?;
+    if adjusts {
+        point = restart.map(|r| RestartPoint::read(r.file, r.increment, &mesh, &pairs)).transpose()?;
+    }
     let factors = setup.load_factors(setup_name)?;
     if let Some(point) = &point {
         if point.remaining(&factors) == 0 {
