@@ -40,6 +40,15 @@ use splinecontact::stages::solve;
 /// A body held only by contact must start touching its master or be supported, and
 /// its rigid in-plane modes need supports (frictionless contact carries no shear).
 ///
+/// Before the first increment sc-solve checks the model as sc-check does: a master
+/// whose normal points away from its slave body is refused (exit code 2; the
+/// message says how to fix it, `allow_flipped_master: true` in the pair's contact
+/// entry overrides), every body's rigid-body modes that no constraint holds are a
+/// warning line ("body 'upper': no constraint holds translation x, …"), and
+/// `adjust: <distance>` in a contact entry moves slave nodes within that distance of
+/// the master onto it, stress-free (the log lists them). Run sc-check first for the
+/// whole picture (gaps and penetrations node by node, a .vtu for ParaView).
+///
 /// Every converged increment is appended to the results file (.scres) at once, so a run
 /// that stops keeps everything it converged, with the contact state (gap, pressure,
 /// multiplier, active flag per slave node; force and augmentations per pair). The

@@ -12,6 +12,7 @@
 //! | `mesh`   | the mesh: nodes, hex8, bodies, node and face sets, hex8 topology |
 //! | `contact` | contact pairs: a master face set ordered into the B-spline control net |
 //! | `spline` | the B-spline master patch and its bilinear-facet counterpart |
+//! | `check`  | the pre-solve check: contact pairs at the start (projections, gaps, flipped masters, adjust), rigid-body modes |
 //! | `stages` | each pipeline stage as a library call (the binaries are thin wrappers) |
 //! | `pipeline` | the YAML pipeline runner |
 //!
@@ -28,6 +29,7 @@
 #![allow(clippy::result_large_err)]
 
 pub mod assembly;
+pub mod check;
 pub mod contact;
 pub mod fem;
 pub mod format;

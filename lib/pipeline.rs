@@ -27,6 +27,19 @@ impl RunError {
     }
 }
 
+/// The setup of a solve or check stage: inline (`setup:`) or from `setup_file:`,
+/// with the name it goes by in messages.
+fn stage_setup(path: &Path, base: &Path, kind: &str, index: usize, inline: &Option<SolveSetup>, file: &Option<PathBuf>) -> Result<(SolveSetup, String), StageRunError> {
+    match (inline, file) {
+        (Some(setup), None) => Ok((setup.clone(), format!("{} ({kind} stage {index})", path.display()))),
+        (None, Some(f)) => {
+            let f = resolve(base, f);
+            Ok((SolveSetup::read(&f)?, f.display().to_string()))
+        }
+        _ => Err(StageRunError::Usage(format!("{}: {kind} stage {index}: give exactly one of `setup` (inline) or `setup_file`", path.display()))),
+    }
+}
+
 fn ensure_parent(p: &Path) -> Result<(), StageRunError> {
     match p.parent() {
         Some(d) if !d.as_os_str().is_empty() && !d.exists() => std::fs::create_dir_all(d)
@@ -75,6 +88,39 @@ pub fn run(path: &Path, verbosity: Verbosity, log: &mut dyn FnMut(&str), warn: &
                     log(&format!("      {line}"));
                 }
             }
+            Stage::Check(s) => {
+                let input = resolve(&base, &s.input);
+                let (setup, setup_name) = stage_setup(path, &base, "check", index, &s.setup, &s.setup_file).map_err(fail)?;
+                let with_ext = |ext: &str| s.output.as_ref().map(|o| {
+                    let mut p = resolve(&base, o).into_os_string();
+                    p.push(".");
+                    p.push(ext);
+                    PathBuf::from(p)
+                });
+                let pick = |explicit: &Option<PathBuf>, ext: &str| explicit.as_ref().map(|p| resolve(&base, p)).or_else(|| with_ext(ext));
+                let (csv, vtu, summary) = (pick(&s.csv, "csv"), pick(&s.vtu, "vtu"), pick(&s.summary, "txt"));
+                let written: Vec<String> = [&csv, &vtu, &summary].into_iter().flatten().map(|p| p.display().to_string()).collect();
+                log(&format!("[{index}/{n}] check {}{}", input.display(), if written.is_empty() { String::new() } else { format!(" -> {}", written.join(", ")) }));
+                for p in [&csv, &vtu, &summary].into_iter().flatten() {
+                    ensure_parent(p).map_err(fail)?;
+                }
+                let outputs = stages::check::CheckOutputs { csv: csv.as_deref(), vtu: vtu.as_deref(), summary: summary.as_deref() };
+                let r = stages::check::check(&input, &setup, &setup_name, outputs).map_err(fail)?;
+                let lines = crate::check::report::summary(&r);
+                for line in lines.iter().filter(|l| !l.starts_with("warning: ") && !l.starts_with("error: ")) {
+                    log(&format!("      {line}"));
+                }
+                for w in r.warnings() {
+                    warn(&w);
+                }
+                let errors = r.errors();
+                if let Some(e) = errors.into_iter().next() {
+                    if s.strict {
+                        return Err(fail(e.into()));
+                    }
+                    warn(&format!("{e} (the solve will refuse it)"));
+                }
+            }
             Stage::Solve(s) => {
                 let (input, out) = (resolve(&base, &s.input), resolve(&base, &s.output));
                 log(&format!("[{index}/{n}] solve {} -> {}", input.display(), out.display()));
@@ -83,19 +129,7 @@ pub fn run(path: &Path, verbosity: Verbosity, log: &mut dyn FnMut(&str), warn: &
                 if s.restart_increment.is_some() && restart_file.is_none() {
                     return Err(fail(StageRunError::Usage(format!("{}: solve stage {index}: `restart_increment` needs `restart` (the results file to continue)", path.display()))));
                 }
-                let (setup, setup_name) = match (&s.setup, &s.setup_file) {
-                    (Some(setup), None) => (setup.clone(), format!("{} (solve stage {index})", path.display())),
-                    (None, Some(f)) => {
-                        let f = resolve(&base, f);
-                        (SolveSetup::read(&f).map_err(|e| fail(e.into()))?, f.display().to_string())
-                    }
-                    _ => {
-                        return Err(fail(StageRunError::Usage(format!(
-                            "{}: solve stage {index}: give exactly one of `setup` (inline) or `setup_file`",
-                            path.display()
-                        ))))
-                    }
-                };
+                let (setup, setup_name) = stage_setup(path, &base, "solve", index, &s.setup, &s.setup_file).map_err(fail)?;
                 let csv = s.csv.as_ref().map(|c| resolve(&base, c)).or_else(|| stages::solve::default_csv_path(&out));
                 let restart = restart_file.as_deref().map(|file| stages::solve::Restart { file, increment: s.restart_increment });
                 let r = stages::solve::solve(&input, &setup, &setup_name, &out, csv.as_deref(), restart, verbosity).map_err(fail)?;

@@ -9,7 +9,9 @@
 //! | [`friction`]  | Coulomb friction of one slave node: trial traction, return mapping (eqs. 4.5–4.9) |
 //! | [`dual`]      | forward-mode dual numbers, for the exact frictional tangent |
 //! | [`pair`]      | one pair during the solve: search, active set, Uzawa updates |
+//! | [`adjust`]    | slave nodes moved onto the master before the first increment (stress-free) |
 
+pub mod adjust;
 pub mod dual;
 pub mod element;
 pub mod friction;

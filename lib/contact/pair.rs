@@ -485,9 +485,26 @@ impl PairSolver {
     /// and then on the patch's extension (see [`Self::search`]): a slave edge flush
     /// with the master edge must not flicker in and out of contact by round-off or by
     /// a lateral strain difference.
-    fn usable(&self, s: usize) -> bool {
+    pub fn usable(&self, s: usize) -> bool {
         let p = &self.projections[s];
         p.inside && p.converged && self.points[s].n_bar.iter().all(|v| v.is_finite())
+    }
+
+    /// The closest-point projection of slave `s` at the last search and the master
+    /// surface at its foot point (n̄, ā_α; meaningful when the projection converged).
+    pub fn foot(&self, s: usize) -> (&Projection, &SurfacePoint) {
+        (&self.projections[s], &self.points[s])
+    }
+
+    /// The capture distance: a slave inside the patch closer than this gets a contact
+    /// element (0.5 h, h the master net's mean edge length).
+    pub fn capture(&self) -> f64 {
+        self.capture
+    }
+
+    /// The edge tolerance of the search (10⁻³ h, see [`Self::usable`]).
+    pub fn edge_tolerance(&self) -> f64 {
+        self.edge_tolerance
     }
 
     /// Appends the node group of every slave that needs a contact element now, and

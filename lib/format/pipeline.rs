@@ -52,6 +52,8 @@ pub enum Stage {
     Gmsh(GmshStage),
     Import(ImportStage),
     Tag(TagStage),
+    /// The pre-solve check of a model and its setup (`sc-check`).
+    Check(CheckStage),
     Solve(SolveStage),
     Export(ExportStage),
     /// Force-history CSVs → a PNG line plot; the keys are [`PlotSpec`]'s.
@@ -64,6 +66,7 @@ impl Stage {
             Self::Gmsh(_) => "gmsh",
             Self::Import(_) => "import",
             Self::Tag(_) => "tag",
+            Self::Check(_) => "check",
             Self::Solve(_) => "solve",
             Self::Export(_) => "export",
             Self::Plot(_) => "plot",
@@ -122,6 +125,31 @@ pub struct SolveStage {
     /// `sc-solve --restart-increment`).
     #[serde(default)]
     pub restart_increment: Option<usize>,
+}
+
+/// Check: a model and a solve setup → the pre-solve check (`sc-check`); the setup
+/// inline (`setup:`, e.g. a YAML alias of the solve stage's) or in a file.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CheckStage {
+    pub input: PathBuf,
+    #[serde(default)]
+    pub setup: Option<SolveSetup>,
+    #[serde(default)]
+    pub setup_file: Option<PathBuf>,
+    /// Write `<output>.csv`, `<output>.vtu` and `<output>.txt`.
+    #[serde(default)]
+    pub output: Option<PathBuf>,
+    /// Or each on its own (these win over `output`).
+    #[serde(default)]
+    pub csv: Option<PathBuf>,
+    #[serde(default)]
+    pub vtu: Option<PathBuf>,
+    #[serde(default)]
+    pub summary: Option<PathBuf>,
+    /// Fail the stage (and the pipeline) on what the solve refuses (a flipped master).
+    #[serde(default)]
+    pub strict: bool,
 }
 
 #[derive(Debug, Deserialize)]
@@ -237,6 +265,20 @@ stages:
         let bad = y.replace("divide_by:", "divde_by:");
         let e = Pipeline::parse("p.yaml", &bad).unwrap_err().to_string();
         assert!(e.contains("divde_by") && e.contains("line 15"), "{e}");
+    }
+
+    #[test]
+    fn check_stage_shares_the_solve_setup_by_an_alias() {
+        let y = "version: 1\nstages:\n  - check:\n      input: m.sccontact\n      output: out/m-check\n      strict: true\n      setup: &s\n        materials: [{body: b, model: linear_elastic, E: 1.0, nu: 0.3}]\n        contact: [{pair: c, adjust: 1.0e-3, allow_flipped_master: true}]\n  - solve: {input: m.sccontact, output: m.scres, setup: *s}\n";
+        let p = Pipeline::parse("p.yaml", y).unwrap();
+        let (Stage::Check(c), Stage::Solve(s)) = (&p.stages[0], &p.stages[1]) else { panic!("not check, solve") };
+        assert!(c.strict && c.output.as_deref() == Some(Path::new("out/m-check")));
+        let (a, b) = (c.setup.as_ref().unwrap(), s.setup.as_ref().unwrap());
+        assert_eq!((a.contact[0].adjust, a.contact[0].allow_flipped_master), (Some(1e-3), true));
+        assert_eq!(serde_yaml::to_string(a).unwrap(), serde_yaml::to_string(b).unwrap());
+        let bad = y.replace("strict: true", "stict: true");
+        let e = Pipeline::parse("p.yaml", &bad).unwrap_err().to_string();
+        assert!(e.contains("stict") && e.contains("line 6"), "{e}");
     }
 
     #[test]

@@ -453,6 +453,20 @@ pub struct ContactSetup {
     /// extrapolated from the last two increments (`solver::stabilization`).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub stabilization: f64,
+    /// Adjust distance (Abaqus ADJUST, ANSYS ICONT): before the first increment,
+    /// every slave node that projects onto the master with |g_N| ≤ this distance is
+    /// moved onto the master, stress-free (its reference coordinates change;
+    /// `contact::adjust`). Absent or 0: off.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub adjust: Option<f64>,
+    /// Solve even though the master normal n̄ points away from the slave body
+    /// (`check::orientation`); without it such a pair is refused.
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub allow_flipped_master: bool,
+}
+
+fn is_false(v: &bool) -> bool {
+    !*v
 }
 
 fn is_zero(v: &f64) -> bool {

@@ -9,6 +9,7 @@ use nalgebra::Vector3;
 
 use super::amplitude::Amplitude;
 use crate::assembly::{DofMap, DOFS_PER_NODE};
+use crate::contact::adjust::{adjust_pair, AdjustError, PairAdjustment};
 use crate::contact::pair::PairSettings;
 use crate::contact::tributary::tributary_areas;
 use crate::format::sccontact::{ContactPair, SlaveKind};
@@ -34,6 +35,8 @@ pub enum ProblemError {
     Material { file: String, body: String, source: MaterialError },
     #[error("{file}: {message}")]
     Invalid { file: String, message: String },
+    #[error("{file}: {source}")]
+    Adjust { file: String, source: AdjustError },
 }
 
 /// A follower pressure on one hexahedron face (nodes outward-oriented).
@@ -66,6 +69,10 @@ pub struct ContactDefinition {
     pub h_master: f64,
     /// ε_N was not given: [`default_penalty`].
     pub eps_n_default: bool,
+    /// `adjust` distance of the setup (None: off).
+    pub adjust: Option<f64>,
+    /// The setup accepts a master whose normal points away from the slave body.
+    pub allow_flipped_master: bool,
 }
 
 /// The problem.
@@ -92,6 +99,10 @@ pub struct Problem {
     pub contact: Vec<ContactDefinition>,
     /// gmsh tag of every node, for messages.
     pub node_tags: Vec<u64>,
+    /// The pairs' `adjust` before the first increment, in pair order (pairs with
+    /// `adjust` only): which slave nodes moved onto the master and how far. `X` holds
+    /// the moved coordinates.
+    pub adjustments: Vec<PairAdjustment>,
 }
 
 fn names(v: Vec<&str>) -> String {
@@ -172,6 +183,11 @@ fn contact_definitions(mesh: &Mesh, pairs: &[ContactPair], setup: &SolveSetup, f
         if !(c.stabilization.is_finite() && c.stabilization >= 0.0) {
             return Err(bad(format!("stabilization must be zero or positive, found {}", c.stabilization)));
         }
+        if let Some(d) = c.adjust {
+            if !(d.is_finite() && d >= 0.0) {
+                return Err(bad(format!("adjust must be a length ≥ 0 (0: off), found {d}")));
+            }
+        }
         let areas = tributary_areas(mesh, &pair.slave_nodes, (pair.slave_kind == SlaveKind::FaceSet).then_some(pair.slave.as_str()));
         let penetration_tolerance = match (c.penetration_tolerance, c.penetration_tolerance_relative) {
             (Some(_), Some(_)) => return Err(bad("give `penetration_tolerance` or `penetration_tolerance_relative`, not both".into())),
@@ -185,6 +201,8 @@ fn contact_definitions(mesh: &Mesh, pairs: &[ContactPair], setup: &SolveSetup, f
             eps_n_default,
             areas,
             h_master: h,
+            adjust: c.adjust.filter(|&d| d != 0.0),
+            allow_flipped_master: c.allow_flipped_master,
         });
     }
     Ok(out)
@@ -371,8 +389,16 @@ impl Problem {
             }
         }
         let contact = contact_definitions(mesh, pairs, setup, file, &materials, &hex_material)?;
+        let mut X: Vec<Vector3<f64>> = mesh.nodes.iter().map(|p| Vector3::new(p[0], p[1], p[2])).collect();
+        // Adjust (Abaqus ADJUST, ANSYS ICONT): slave nodes onto the master, stress-free.
+        let mut adjustments = Vec::new();
+        for def in &contact {
+            if let Some(d) = def.adjust {
+                adjustments.push(adjust_pair(def, d, &mut X, &mesh.hexes, &mesh.node_tags, &mesh.element_tags).map_err(|source| ProblemError::Adjust { file: file.into(), source })?);
+            }
+        }
         Ok(Self {
-            X: mesh.nodes.iter().map(|p| Vector3::new(p[0], p[1], p[2])).collect(),
+            X,
             hexes: mesh.hexes.clone(),
             hex_material,
             materials,
@@ -388,6 +414,7 @@ impl Problem {
             reaction_sets,
             contact,
             node_tags: mesh.node_tags.clone(),
+            adjustments,
         })
     }
 

@@ -2,6 +2,7 @@
 //! and the pipeline runner call these same functions, so a stage behaves the same
 //! from the shell and from a pipeline YAML.
 
+pub mod check;
 pub mod export;
 pub mod gmsh;
 pub mod import;
@@ -9,6 +10,7 @@ pub mod plot;
 pub mod solve;
 pub mod tag;
 
+use crate::check::CheckError;
 use crate::format::msh::MshError;
 use crate::format::setup::SetupError;
 use crate::solver::increments::SolveError;
@@ -53,6 +55,8 @@ pub enum StageRunError {
     Tag(#[from] TagError),
     #[error(transparent)]
     Plot(#[from] PlotError),
+    #[error(transparent)]
+    Check(#[from] CheckError),
     #[error("{0}")]
     Usage(String),
     #[error("{0}")]

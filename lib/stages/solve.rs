@@ -40,6 +40,20 @@ pub fn default_csv_path(output: &Path) -> Option<std::path::PathBuf> {
     (output.as_os_str() != "-").then(|| output.with_extension("convergence.csv"))
 }
 
+/// The mesh and contact pairs of a `.scmesh` (no pairs) or `.sccontact` file, as
+/// `sc-solve` and `sc-check` read them.
+pub fn read_model(input: &Path) -> Result<(crate::mesh::Mesh, Vec<crate::format::sccontact::ContactPair>), StageRunError> {
+    let file = StageFile::read_known(input, &[(scmesh::FORMAT, scmesh::MAJOR), (sccontact::FORMAT, sccontact::MAJOR)])?;
+    match file.format.as_str() {
+        scmesh::FORMAT => Ok((scmesh::from_stage(&file)?, Vec::new())),
+        sccontact::FORMAT => {
+            let model = ContactModel::from_stage(&file)?;
+            Ok((model.mesh, model.pairs))
+        }
+        other => Err(StageRunError::Usage(format!("{}: a {other} file; a mesh (.scmesh) or a contact model (.sccontact) is read", input.display()))),
+    }
+}
+
 /// Solve `setup` on the mesh in `input`, writing `output` after every converged
 /// increment and the convergence history to `csv`; with `restart`, continue from an
 /// increment of that results file (of the same model; by default its last), whose
@@ -50,17 +64,25 @@ pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, 
         return Err(StageRunError::Usage("sc-solve writes its results after every increment: give a file with -o, not -".into()));
     }
     let start = Instant::now();
-    let file = StageFile::read_known(input, &[(scmesh::FORMAT, scmesh::MAJOR), (sccontact::FORMAT, sccontact::MAJOR)])?;
-    let (mesh, pairs) = match file.format.as_str() {
-        scmesh::FORMAT => (scmesh::from_stage(&file)?, Vec::new()),
-        sccontact::FORMAT => {
-            let model = ContactModel::from_stage(&file)?;
-            (model.mesh, model.pairs)
-        }
-        other => return Err(StageRunError::Usage(format!("{}: a {other} file; sc-solve reads a mesh (.scmesh) or a contact model (.sccontact)", input.display()))),
-    };
-    let point = restart.map(|r| RestartPoint::read(r.file, r.increment, &mesh, &pairs)).transpose()?;
+    let (mut mesh, pairs) = read_model(input)?;
+    // A restart file of another model is named before the setup is checked against
+    // this one; with `adjust` the file holds the adjusted coordinates, so it is
+    // compared with them, once the problem has moved the nodes.
+    let adjusts = setup.contact.iter().any(|c| c.adjust.is_some_and(|d| d != 0.0));
+    let mut point = if adjusts { None } else { restart.map(|r| RestartPoint::read(r.file, r.increment, &mesh, &pairs)).transpose()? };
     let problem = Problem::with_contact(&mesh, &pairs, setup, setup_name)?;
+    // the pre-solve check: a flipped master stops here; free rigid modes are warned about
+    let check = crate::check::run(&mesh, &problem, &input.display().to_string(), setup_name)?;
+    if let Some(e) = check.errors().into_iter().next() {
+        return Err(e.into());
+    }
+    if !problem.adjustments.is_empty() {
+        // the adjusted reference coordinates are the model's from here on (results, restart)
+        mesh.nodes = problem.X.iter().map(|x| [x[0], x[1], x[2]]).collect();
+    }
+    if adjusts {
+        point = restart.map(|r| RestartPoint::read(r.file, r.increment, &mesh, &pairs)).transpose()?;
+    }
     let factors = setup.load_factors(setup_name)?;
     if let Some(point) = &point {
         if point.remaining(&factors) == 0 {
@@ -102,6 +124,12 @@ pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, 
                 String::new()
             }
         ));
+    }
+    for line in crate::check::report::solve_start_lines(&check) {
+        log.line(&line);
+    }
+    for w in crate::check::report::solve_start_warnings(&check) {
+        log.warning(&w);
     }
     if !setup.linear_solver.petsc.options.trim().is_empty() && !newton.linear_solver_name().starts_with("petsc") {
         log.warning(&format!(

@@ -1,4 +1,5 @@
 mod bad_input;
+mod check;
 mod import_export;
 mod pipeline;
 mod plot;

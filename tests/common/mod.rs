@@ -19,6 +19,7 @@ pub fn run(bin: &str, args: &[&str], dir: &Path) -> Output {
         "sc-solve" => env!("CARGO_BIN_EXE_sc-solve"),
         "sc-tag" => env!("CARGO_BIN_EXE_sc-tag"),
         "sc-plot" => env!("CARGO_BIN_EXE_sc-plot"),
+        "sc-check" => env!("CARGO_BIN_EXE_sc-check"),
         other => panic!("unknown binary {other}"),
     };
     Command::new(exe).args(args).current_dir(dir).output().expect("binary runs")
