@@ -77,6 +77,16 @@ def plot(results, png):
     fig.savefig(png, dpi=110)
 
 
+def report(results, add, png):
+    """Print the table of `results` (with the rows of the JSON file `add`) and plot it to `png`."""
+    if add:
+        for name, rows in json.loads(Path(add).read_text()).items():
+            results.setdefault(name, []).extend(rows)
+    print(table(results))
+    if png:
+        plot(results, png)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0], formatter_class=argparse.RawDescriptionHelpFormatter,
                                  epilog=__doc__.split("\n", 2)[2])
@@ -92,13 +102,7 @@ def main():
                     help="do not run: read a scaling.json written before (plus --add) and print and plot it")
     a = ap.parse_args()
     if a.replot:
-        results = json.loads(Path(a.replot).read_text())
-        if a.add:
-            for name, rows in json.loads(Path(a.add).read_text()).items():
-                results.setdefault(name, []).extend(rows)
-        print(table(results))
-        if a.plot:
-            plot(results, a.plot)
+        report(json.loads(Path(a.replot).read_text()), a.add, a.plot)
         return
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -110,12 +114,7 @@ def main():
         results[name] = run_variant(name, levels, out)
         print("%s done" % name, file=sys.stderr)
     (out / "scaling.json").write_text(json.dumps(results, indent=1) + "\n")
-    if a.add:
-        for name, rows in json.loads(Path(a.add).read_text()).items():
-            results.setdefault(name, []).extend(rows)
-    print(table(results))
-    if a.plot:
-        plot(results, a.plot)
+    report(results, a.add, a.plot)
 
 
 if __name__ == "__main__":

@@ -149,17 +149,7 @@ impl CheckReport {
                 ));
             }
         }
-        for b in &self.bodies {
-            if b.free.is_empty() {
-                continue;
-            }
-            let held = if b.contact_pairs.is_empty() {
-                "and no contact pair touches the body: expect a singular tangent".to_string()
-            } else {
-                format!("only contact ({}) can", b.contact_pairs.iter().map(|p| format!("pair '{p}'")).collect::<Vec<_>>().join(", "))
-            };
-            w.push(format!("body '{}': no constraint holds {}; {held}", b.name, b.free_list()));
-        }
+        w.extend(self.bodies.iter().filter_map(BodyModes::warning));
         w
     }
 }

@@ -262,16 +262,6 @@ pub fn solve_start_warnings(r: &CheckReport) -> Vec<String> {
             ));
         }
     }
-    for b in &r.bodies {
-        if b.free.is_empty() {
-            continue;
-        }
-        let held = if b.contact_pairs.is_empty() {
-            "and no contact pair touches the body: expect a singular tangent".to_string()
-        } else {
-            format!("only contact ({}) can", b.contact_pairs.iter().map(|p| format!("pair '{p}'")).collect::<Vec<_>>().join(", "))
-        };
-        out.push(format!("body '{}': no constraint holds {}; {held}", b.name, b.free_list()));
-    }
+    out.extend(r.bodies.iter().filter_map(crate::check::rigid_modes::BodyModes::warning));
     out
 }

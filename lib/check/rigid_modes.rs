@@ -1,6 +1,5 @@
 //! Rigid-body modes that no Dirichlet condition holds: the zero-energy modes of each
 //! body under its constraints, found before the first solve.
-#![allow(non_snake_case)] // paper notation: X (reference coordinates)
 //!
 //! **Bodies.** The connected components of the hexahedral mesh (hexahedra sharing a
 //! node belong together, across physical volumes: a glued interface makes one
@@ -28,6 +27,7 @@
 //! another): the solve warns, it does not fail. The touching-node rule
 //! (`docs/theory/contact.md`, "Touching nodes") gives it normal stiffness at a zero
 //! gap; its tangential modes need friction in stick, or supports.
+#![allow(non_snake_case)] // paper notation: X (reference coordinates)
 
 use nalgebra::{Matrix6, Vector3, Vector6};
 
@@ -162,6 +162,19 @@ impl BodyModes {
     /// "translation x, translation y, rotation about z".
     pub fn free_list(&self) -> String {
         self.free.iter().map(FreeMode::describe).collect::<Vec<_>>().join(", ")
+    }
+
+    /// The warning about a body with free modes (`None` when the constraints hold all six).
+    pub fn warning(&self) -> Option<String> {
+        if self.free.is_empty() {
+            return None;
+        }
+        let held = if self.contact_pairs.is_empty() {
+            "and no contact pair touches the body: expect a singular tangent".to_string()
+        } else {
+            format!("only contact ({}) can", self.contact_pairs.iter().map(|p| format!("pair '{p}'")).collect::<Vec<_>>().join(", "))
+        };
+        Some(format!("body '{}': no constraint holds {}; {held}", self.name, self.free_list()))
     }
 }
 

@@ -1,7 +1,6 @@
 //! Adjust: close small initial gaps and overlaps before the first increment by moving
 //! slave nodes onto the master, stress-free (Abaqus `*CONTACT PAIR, ADJUST`, ANSYS
 //! `ICONT`).
-#![allow(non_snake_case)] // paper notation: X (reference coordinates)
 //!
 //! For a pair with `adjust: δ`, every slave node whose closest-point projection
 //! (eq. 2.2) lies on the master (inside the patch, or within the edge tolerance of
@@ -17,6 +16,7 @@
 //! adjusted in the setup's order, each against the coordinates the pairs before it
 //! left. A move that would invert an element (det J₀ ≤ 0 at a Gauss point) is
 //! refused: the adjust distance is then larger than the elements can take.
+#![allow(non_snake_case)] // paper notation: X (reference coordinates)
 
 use nalgebra::Vector3;
 

@@ -600,6 +600,21 @@ impl PairSolver {
         a[0] * (xi[0] - law.xi_n[0]) + a[1] * (xi[1] - law.xi_n[1])
     }
 
+    /// The mesh nodes of the control points that carry slave `s`'s contact element
+    /// (its master side; empty when it has no foot point on the master).
+    pub fn master_nodes_of(&self, s: usize) -> impl Iterator<Item = u32> + '_ {
+        let nodes = if self.usable(s) { self.points[s].basis.nodes() } else { &[] };
+        nodes.iter().map(|&k| self.net[k])
+    }
+
+    /// The contact frame at slave `s`'s foot point at the last search: n̄ and two
+    /// unit tangents orthogonal to it and to each other (ā_1 normalised, n̄ × it).
+    pub fn contact_frame(&self, s: usize) -> (Vec3, [Vec3; 2]) {
+        let sp = &self.points[s];
+        let t1 = sp.a_alpha[0].normalize();
+        (sp.n_bar, [t1, sp.n_bar.cross(&t1)])
+    }
+
     /// Slaves sticking and slipping (active ones, frictional pairs).
     pub fn n_stick_slip(&self) -> (usize, usize) {
         let slip = self.slipping.iter().filter(|&&b| b).count();
@@ -825,7 +840,7 @@ mod tests {
             net: ControlNet { a, b, nodes: (0..30).collect() },
         };
         let settings = PairSettings { eps_n: 1e3, enforcement: Enforcement::Penalty, penetration_tolerance: 1e-3, max_augmentations: 0, update_halvings: 0, mu: 0.0, eps_t: 0.0, stabilization: 0.0 };
-        let def = ContactDefinition { pair, settings, areas: vec![0.01; 40], h_master: 0.2, eps_n_default: false };
+        let def = ContactDefinition { pair, settings, areas: vec![0.01; 40], h_master: 0.2, eps_n_default: false, adjust: None, allow_flipped_master: false };
         let solver = PairSolver::new(&def, &x).unwrap();
         (x, solver)
     }

@@ -253,6 +253,17 @@ pub fn hex8_gauss_stresses(
     Ok(out)
 }
 
+/// Strain energy ∫ W(F) dV of the element (reference volume, 2×2×2 Gauss points).
+pub fn hex8_strain_energy(X: &[Vector3<f64>; 8], u: &[Vector3<f64>; 8], mat: &MaterialModel) -> Result<f64, ElementError> {
+    let mut w = 0.0;
+    for q in 0..8 {
+        let (G, det0) = gauss_reference(X, q)?;
+        let F = deformation_gradient(&G, u);
+        w += mat.energy(&F).map_err(|e| material_error(q, e))? * det0;
+    }
+    Ok(w)
+}
+
 /// Smallest volume ratio J = det F = det(∂x/∂ξ) / det(∂X/∂ξ) over the 8 Gauss points
 /// (may be ≤ 0: this is the inversion check, it does not fail on it). Fails only on
 /// a degenerate reference element.

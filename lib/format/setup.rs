@@ -197,6 +197,10 @@ pub struct NewtonSetup {
     /// lengths; a longer correction is shortened to it (0: no limit).
     #[serde(default = "default_penetration_step_limit")]
     pub penetration_step_limit: f64,
+    /// Viscous damping β of the bodies whose rigid modes no constraint holds, as a
+    /// share of an element's nodal stiffness G h̄ (`solver::free_bodies`; 0: off).
+    #[serde(default)]
+    pub free_body_damping: f64,
 }
 
 fn default_max_iterations() -> u32 {
@@ -231,6 +235,7 @@ impl Default for NewtonSetup {
             line_search: true,
             max_step_halvings: default_step_halvings(),
             penetration_step_limit: default_penetration_step_limit(),
+            free_body_damping: 0.0,
         }
     }
 }

@@ -224,6 +224,7 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
     let n_inc = factors.len();
     for (k, &target) in factors.iter().enumerate().skip(first) {
         let mut lambda = target;
+        newton.planned_step = Some(target - if k == 0 { 0.0 } else { factors[k - 1] });
         let mut failures = 0u32;
         let mut cutbacks_this = 0u32;
         loop {
@@ -287,7 +288,29 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
                     for pair in &mut newton.contact {
                         pair.commit();
                     }
-                    newton.commit_increment(&u, lambda);
+                    if let Some(d) = newton.commit_increment(&u, lambda) {
+                        // ALLSD / ALLSE of Abaqus: the damping's work against the strain energy
+                        let ratio = if d.strain_energy > 0.0 { d.dissipated_total / d.strain_energy } else { f64::INFINITY };
+                        log.line(&format!(
+                            "increment {}/{n_inc}: free-body damping dissipated {:.3e} in this increment, {:.3e} in all: {:.2e} of the strain energy {:.3e}",
+                            k + 1,
+                            d.dissipated,
+                            d.dissipated_total,
+                            ratio,
+                            d.strain_energy
+                        ));
+                        if ratio > crate::solver::free_bodies::ENERGY_WARNING && d.dissipated_total > 0.0 {
+                            log.line(&format!(
+                                "warning: increment {}/{n_inc}: the free-body damping has dissipated {:.1} % of the strain energy (more than {} %): it carries load the model should carry; lower newton.free_body_damping or hold the body",
+                                k + 1,
+                                100.0 * ratio,
+                                100.0 * crate::solver::free_bodies::ENERGY_WARNING
+                            ));
+                        }
+                        for name in d.released {
+                            log.line(&format!("increment {}/{n_inc}: contact holds body '{name}': its damping is off from the next increment", k + 1));
+                        }
+                    }
                     results.increments.push(Increment {
                         info: IncrementInfo { load_factor: lambda, cutbacks: cutbacks_this, iterations: conv.iterations, reactions, seconds_output: t.elapsed().as_secs_f64(), contact: summaries },
                         u: u.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),

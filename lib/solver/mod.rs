@@ -2,7 +2,7 @@
 //! fill-reducing orderings ([`ordering`]), GMRES ([`gmres`]), an inexact Newton's
 //! forcing terms ([`forcing`]) and the frictional
 //! tangent's symmetric-part-preconditioned solver ([`symmetric_part`]),
-//! the static problem ([`problem`]) and its load curves ([`amplitude`]), Newton–Raphson for one increment ([`newton`]),
+//! the damping of bodies only contact holds ([`free_bodies`]), the static problem ([`problem`]) and its load curves ([`amplitude`]), Newton–Raphson for one increment ([`newton`]),
 //! the augmented Lagrangian's Uzawa loop ([`uzawa`]), the master-surface
 //! stabilisation ([`stabilization`]), load
 //! stepping with cutbacks ([`increments`]), restarting from a results file ([`restart`]), what the user sees ([`log`]), and a
@@ -12,6 +12,7 @@ pub mod amplitude;
 pub mod bench;
 pub mod block_rows;
 pub mod forcing;
+pub mod free_bodies;
 pub mod gmres;
 pub mod increments;
 pub mod linear;

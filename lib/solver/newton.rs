@@ -16,6 +16,7 @@ use std::time::Instant;
 use nalgebra::{DMatrix, DVector, Vector3};
 
 use super::forcing::Forcing;
+use super::free_bodies::{DampingReport, FreeBody, FreeBodyDamping};
 use super::problem::Problem;
 use super::ranks;
 use super::stabilization::Stabilization;
@@ -151,6 +152,10 @@ pub struct Newton<'p> {
     pub line_search_steps: u32,
     /// The master-surface stabilisation of the pairs that ask for one.
     pub stabilization: Option<Stabilization>,
+    /// The damping of the bodies only contact holds (`newton.free_body_damping`).
+    pub free_bodies: Option<FreeBodyDamping>,
+    /// λ of the last converged increment.
+    lambda_n: f64,
     /// The iteration at which the current solve held the contact search's master
     /// elements, and why ([`PairSolver::freeze`]); `None` while they may change.
     pub frozen_at: Option<(u32, &'static str)>,
@@ -160,6 +165,9 @@ pub struct Newton<'p> {
     pub notes: Vec<String>,
     /// Corrections shortened by the penetration step limit (all solves).
     pub penetration_limits: u32,
+    /// The length the schedule planned for the increment being solved (the
+    /// stabilisation stiffens when a cutback shortens it).
+    pub planned_step: Option<f64>,
     /// A full-length Newton correction (storage reused by the step limit).
     du_full: Vec<f64>,
     /// Inexact Newton: an iterative linear solver's tolerance follows the residual
@@ -268,9 +276,12 @@ impl<'p> Newton<'p> {
             step_halvings: 0,
             line_search_steps: 0,
             stabilization,
+            free_bodies: None,
+            lambda_n: 0.0,
             frozen_at: None,
             notes: Vec::new(),
             penetration_limits: 0,
+            planned_step: None,
             du_full: vec![0.0; n],
             forcing,
         })
@@ -336,11 +347,23 @@ impl<'p> Newton<'p> {
         self.contact.iter_mut().for_each(PairSolver::release);
     }
 
-    /// Accept the converged state `u` at `lambda` (the stabilisation's history).
-    pub fn commit_increment(&mut self, u: &[f64], lambda: f64) {
+    /// Damp the bodies only contact holds (`bodies`, from the pre-solve check) with
+    /// β = `beta` ([`FreeBodyDamping`]); nothing when there are none or β ≤ 0.
+    pub fn damp_free_bodies(&mut self, bodies: Vec<FreeBody>, beta: f64) {
+        if beta > 0.0 && bodies.iter().any(|b| !b.free.is_empty()) {
+            self.free_bodies = Some(FreeBodyDamping::new(self.problem, bodies, beta));
+        }
+    }
+
+    /// Accept the converged state `u` at `lambda` (the stabilisation's history; the
+    /// free bodies' damping reports what it dissipated).
+    pub fn commit_increment(&mut self, u: &[f64], lambda: f64) -> Option<DampingReport> {
         if let Some(s) = &mut self.stabilization {
             s.commit(u, lambda);
         }
+        self.lambda_n = lambda;
+        let (problem, contact) = (self.problem, &self.contact);
+        self.free_bodies.as_mut().map(|f| f.commit(problem, u, contact))
     }
 
     /// Continue from the converged increments of a results file: the stabilisation
@@ -352,6 +375,9 @@ impl<'p> Newton<'p> {
         let tail = &increments[increments.len().saturating_sub(2)..];
         for inc in tail {
             self.commit_increment(&inc.displacements(), inc.info.load_factor);
+        }
+        if let (Some(f), Some(last)) = (&mut self.free_bodies, tail.last()) {
+            f.restart_from(&last.displacements());
         }
         let Some(last) = tail.last() else { return Ok(()) };
         for (p, pair) in self.contact.iter_mut().enumerate() {
@@ -467,6 +493,10 @@ impl<'p> Newton<'p> {
             s.add_residual(u, &mut self.residual);
             s.add_tangent(&self.pattern, self.assembly.values_mut());
         }
+        if let Some(f) = &self.free_bodies {
+            f.add_residual(u, &mut self.residual);
+            f.add_tangent(&self.pattern, self.assembly.values_mut());
+        }
         Ok(())
     }
 
@@ -479,7 +509,10 @@ impl<'p> Newton<'p> {
         }
         p.external_force(lambda, &mut self.f_ext);
         if let Some(s) = &mut self.stabilization {
-            s.predict(lambda);
+            s.predict(lambda, self.planned_step);
+        }
+        if let Some(f) = &mut self.free_bodies {
+            f.predict(lambda, self.lambda_n, self.planned_step);
         }
         let ext_norm = self.f_ext.iter().map(|v| v * v).sum::<f64>().sqrt();
         let mut log = Vec::new();
@@ -666,7 +699,7 @@ impl<'p> Newton<'p> {
     /// search, so all take the same step.
     fn limit_penetration(&mut self, iteration: u32) {
         let depth = self.settings.penetration_step_limit;
-        if !(depth > 0.0) || self.contact.is_empty() {
+        if depth.is_nan() || depth <= 0.0 || self.contact.is_empty() {
             return;
         }
         self.du_full.iter_mut().for_each(|d| *d = 0.0);

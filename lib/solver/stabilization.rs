@@ -24,6 +24,17 @@
 //! and vanishes for motion linear in λ. Every converged increment reports its size
 //! (`stabilization_force` in the `.scres` pair summary and the forces CSV), to be
 //! compared with the contact force.
+//!
+//! **It follows the step.** An inertia force is M ü ≈ M (u − u_pred) / Δt²: with the
+//! load factor as pseudo-time and the mass fixed at c Δλ̂² for the planned step Δλ̂
+//! of the increment, a step cut back to Δλ gets
+//! ```text
+//! c(Δλ) = c (Δλ̂ / Δλ)²                  (never less than c)
+//! ```
+//! so each halving makes it four times stiffer, where a constant c would give the
+//! smaller step nothing more to work with: the deviation u − u_pred shrinks like
+//! Δλ², and the force M ü stays what the snap needs. An increment that is not cut
+//! back sees c itself.
 
 use super::problem::Problem;
 use crate::assembly::Pattern;
@@ -41,6 +52,8 @@ pub struct Stabilization {
     before: Option<(Vec<f64>, f64)>,
     /// u_pred at the load factor of the current solve.
     u_pred: Vec<f64>,
+    /// (Δλ̂ / Δλ)² of the current solve: how much stiffer a cut-back step makes it.
+    scale: f64,
 }
 
 impl Stabilization {
@@ -69,12 +82,18 @@ impl Stabilization {
         if pairs.is_empty() {
             return None;
         }
-        Some(Self { c, pairs, last: (vec![0.0; n], 0.0), before: None, u_pred: vec![0.0; n] })
+        Some(Self { c, pairs, last: (vec![0.0; n], 0.0), before: None, u_pred: vec![0.0; n], scale: 1.0 })
     }
 
-    /// Extrapolate the converged history to the load factor `lambda` of the next solve.
-    pub fn predict(&mut self, lambda: f64) {
+    /// Extrapolate the converged history to the load factor `lambda` of the next solve,
+    /// whose increment was planned `planned` long (`None`: as long as it is).
+    pub fn predict(&mut self, lambda: f64, planned: Option<f64>) {
         let (u_n, lambda_n) = (&self.last.0, self.last.1);
+        let step = lambda - lambda_n;
+        self.scale = match planned {
+            Some(p) if step > 0.0 && p > step => (p / step).powi(2),
+            _ => 1.0,
+        };
         match &self.before {
             Some((u_b, lambda_b)) if lambda_n > *lambda_b => {
                 let f = (lambda - lambda_n) / (lambda_n - lambda_b);
@@ -92,16 +111,21 @@ impl Stabilization {
         self.before = Some(last);
     }
 
-    /// residual += f = c (u − u_pred).
+    /// The stiffness factor of the current solve, (Δλ̂ / Δλ)² (1 unless cut back).
+    pub fn scale(&self) -> f64 {
+        self.scale
+    }
+
+    /// residual += f = c(Δλ) (u − u_pred).
     pub fn add_residual(&self, u: &[f64], residual: &mut [f64]) {
         for ((r, &c), (&x, &p)) in residual.iter_mut().zip(&self.c).zip(u.iter().zip(&self.u_pred)) {
             if c > 0.0 {
-                *r += c * (x - p);
+                *r += self.scale * c * (x - p);
             }
         }
     }
 
-    /// K_ff += c on the diagonal (`values` in the layout of `pattern`).
+    /// K_ff += c(Δλ) on the diagonal (`values` in the layout of `pattern`).
     pub fn add_tangent(&self, pattern: &Pattern, values: &mut [f64]) {
         let (col_ptr, row_idx) = (pattern.col_ptr(), pattern.row_idx());
         for (j, &global) in pattern.dofs().global_of_free().iter().enumerate() {
@@ -109,7 +133,7 @@ impl Stabilization {
             if c > 0.0 {
                 // rows are sorted within a column; the diagonal is always stored
                 if let Ok(k) = row_idx[col_ptr[j]..col_ptr[j + 1]].binary_search(&j) {
-                    values[col_ptr[j] + k] += c;
+                    values[col_ptr[j] + k] += self.scale * c;
                 }
             }
         }
@@ -120,7 +144,7 @@ impl Stabilization {
         self.pairs
             .iter()
             .map(|(k, dofs)| {
-                let sum: f64 = dofs.iter().map(|&d| (self.c[d as usize] * (u[d as usize] - self.u_pred[d as usize])).powi(2)).sum();
+                let sum: f64 = dofs.iter().map(|&d| (self.scale * self.c[d as usize] * (u[d as usize] - self.u_pred[d as usize])).powi(2)).sum();
                 (*k, sum.sqrt())
             })
             .collect()
@@ -138,7 +162,7 @@ mod tests {
             c[d] = v;
         }
         let dofs = c_of.iter().map(|&(d, _)| d as u32).collect();
-        Stabilization { c, pairs: vec![(0, dofs)], last: (vec![0.0; n], 0.0), before: None, u_pred: vec![0.0; n] }
+        Stabilization { c, pairs: vec![(0, dofs)], last: (vec![0.0; n], 0.0), before: None, u_pred: vec![0.0; n], scale: 1.0 }
     }
 
     #[test]
@@ -150,7 +174,7 @@ mod tests {
         s.last = (u(0.0), 0.0);
         s.commit(&u(0.1), 0.1);
         s.commit(&u(0.15), 0.15);
-        s.predict(0.4);
+        s.predict(0.4, None);
         let mut r = vec![0.0; 3];
         s.add_residual(&u(0.4), &mut r);
         assert!(r.iter().all(|v| v.abs() < 1e-12), "{r:?}");
@@ -162,7 +186,7 @@ mod tests {
         let mut s = bare(2, &[(1, 4.0)]);
         s.commit(&[0.0, 1.0], 1.0);
         s.commit(&[0.0, 3.0], 2.0);
-        s.predict(2.5); // u_pred = 3 + 0.5 · 2 = 4
+        s.predict(2.5, None); // u_pred = 3 + 0.5 · 2 = 4
         let mut r = vec![0.5, 0.5];
         s.add_residual(&[7.0, 4.5], &mut r);
         // the unstabilised dof keeps its residual; the other gets 4 · (4.5 − 4)
@@ -170,9 +194,38 @@ mod tests {
         assert!((s.forces(&[7.0, 4.5])[0].1 - 2.0).abs() < 1e-12);
         // before the second converged increment: no extrapolation (u_pred = u_n)
         let mut first = bare(2, &[(1, 4.0)]);
-        first.predict(0.3);
+        first.predict(0.3, Some(0.3));
         let mut r = vec![0.0; 2];
         first.add_residual(&[0.0, 0.25], &mut r);
         assert_eq!(r, vec![0.0, 1.0]);
+    }
+
+    #[test]
+    fn a_cut_back_step_makes_it_stiffer_by_the_square_of_the_cut() {
+        let mut s = bare(2, &[(1, 4.0)]);
+        s.commit(&[0.0, 1.0], 1.0);
+        s.commit(&[0.0, 3.0], 2.0);
+        // planned 2 → 3, cut back to 2 → 2.5: c × (1 / 0.5)² = 16; u_pred = 4
+        s.predict(2.5, Some(1.0));
+        assert_eq!(s.scale(), 4.0);
+        let mut r = vec![0.0; 2];
+        s.add_residual(&[0.0, 4.5], &mut r);
+        assert_eq!(r, vec![0.0, 8.0]);
+        assert!((s.forces(&[0.0, 4.5])[0].1 - 8.0).abs() < 1e-12);
+        // the tangent takes the same factor
+        let (nodes, hexes) = crate::assembly::pattern::structured_hex_grid(1, 1, 1);
+        let dofs = crate::assembly::DofMap::from_constrained_mask(&vec![false; 3 * nodes.len()]).unwrap();
+        let pattern = crate::assembly::Pattern::build(dofs, &hexes, crate::assembly::NodeGroups::new()).unwrap();
+        let mut big = bare(3 * nodes.len(), &[(1, 4.0)]);
+        big.commit(&vec![0.0; 3 * nodes.len()], 1.0);
+        big.predict(1.25, Some(1.0));
+        let mut values = vec![0.0; pattern.nnz()];
+        big.add_tangent(&pattern, &mut values);
+        assert_eq!(values.iter().sum::<f64>(), 16.0 * 4.0);
+        // a step as planned, or longer, keeps c
+        s.predict(3.0, Some(1.0));
+        assert_eq!(s.scale(), 1.0);
+        s.predict(2.5, None);
+        assert_eq!(s.scale(), 1.0);
     }
 }

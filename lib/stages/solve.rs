@@ -10,6 +10,7 @@ use crate::format::scmesh;
 use crate::format::stage::StageFile;
 use crate::format::scres::{RestartOrigin, Results, RunStatus};
 use crate::format::setup::SolveSetup;
+use crate::solver::free_bodies::FreeBody;
 use crate::solver::increments::{self, Outputs};
 use crate::solver::log::{SolveLog, Verbosity};
 use crate::solver::newton::Newton;
@@ -130,6 +131,28 @@ pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, 
     }
     for w in crate::check::report::solve_start_warnings(&check) {
         log.warning(&w);
+    }
+    let free: Vec<_> = check.bodies.iter().filter(|b| !b.free.is_empty()).collect();
+    if !free.is_empty() {
+        let beta = setup.newton.free_body_damping;
+        if beta > 0.0 {
+            let components = crate::check::rigid_modes::components(&mesh);
+            let bodies = free
+                .iter()
+                .filter_map(|b| {
+                    let c = components.iter().find(|c| c.name == b.name)?;
+                    Some(FreeBody { name: b.name.clone(), nodes: c.nodes.clone(), free: b.free.iter().map(|m| m.0).collect(), centroid: b.centroid.into(), length: b.length })
+                })
+                .collect();
+            newton.damp_free_bodies(bodies, beta);
+            if let Some(f) = &newton.free_bodies {
+                for (body, c, _) in f.bodies() {
+                    log.line(&format!("free-body damping of body '{}': c = β G h̄ = {c:.4e} on its {} nodes, until contact holds it (newton.free_body_damping β = {beta})", body.name, body.nodes.len()));
+                }
+            }
+        } else {
+            log.line("newton.free_body_damping (e.g. 1.0e-3) damps such a body until contact holds it, if the solve does not start (docs/diagnosing.md)");
+        }
     }
     if !setup.linear_solver.petsc.options.trim().is_empty() && !newton.linear_solver_name().starts_with("petsc") {
         log.warning(&format!(
