@@ -160,7 +160,9 @@ fn assembled_contact_tangent_matches_finite_differences() {
     // ε_T = 1e4 makes most slide (non-symmetric tangent), the central ones stick
     // and frictionless with the master-surface stabilisation (its c (u − u_pred) on the
     // master's free nodes, c = 0.5 ε_N Ā_s ≈ 31, of the order of the contact springs)
-    let friction = [None, Some("mu: 0.3, eps_t: 2.0"), Some("mu: 0.3, eps_t: 1.0e4"), Some("stabilization: 0.5")];
+    // and frictionless with the free-body damping of the upper block (c (u − u_n) on its
+    // free dofs, β = 0.5: c = 0.5 G h̄, of the order of an element's stiffness)
+    let friction = [None, Some("mu: 0.3, eps_t: 2.0"), Some("mu: 0.3, eps_t: 1.0e4"), Some("stabilization: 0.5"), Some("free_body_damping")];
     for ((kind, orders), fr) in [(MasterKind::Facet, None), (MasterKind::Bspline, Some([2, 2])), (MasterKind::Bspline, Some([3, 3])), (MasterKind::Bspline, Some([4, 4]))]
         .into_iter()
         .flat_map(|k| friction.iter().map(move |f| (k, *f)))
@@ -174,12 +176,18 @@ fn assembled_contact_tangent_matches_finite_differences() {
         }
         let model = build_model(mesh.clone(), "t", &[pair(kind, orders, "upper_z0", "lower_z1")]).unwrap();
         let mut yaml = patch_setup("augmented_lagrangian", 1.0e3, 0.0);
-        if let Some(f) = fr {
+        if let Some(f) = fr.filter(|f| *f != "free_body_damping") {
             yaml = yaml.replace("max_augmentations: 30}", &format!("max_augmentations: 30, {f}}}"));
         }
         let setup = SolveSetup::parse("s", &yaml).unwrap();
         let problem = Problem::with_contact(&model.mesh, &model.pairs, &setup, "s").unwrap();
         let mut newton = Newton::new(&problem, setup.newton.clone(), setup.linear_solver.clone()).unwrap();
+        if fr == Some("free_body_damping") {
+            use splinecontact::solver::free_bodies::FreeBody;
+            let upper = FreeBody { name: "upper".into(), nodes: (75..mesh.nodes.len() as u32).collect(), free: vec![[1.0, 0.0, 0.0, 0.0, 0.0, 0.0]], centroid: nalgebra::Vector3::new(0.5, 0.5, 0.75), length: 0.4 };
+            newton.damp_free_bodies(vec![upper], 0.5);
+            assert!(newton.free_bodies.is_some());
+        }
         // the slave block shrunk by 10 % in x and y about the centre (so its edge nodes
         // project into the master's edge spans, not beyond), sheared, moved 0.02 down
         let n = mesh.nodes.len();
