@@ -1,5 +1,5 @@
 // 3D ironing after Puso & Laursen 2004 (CMAME 193, "A mortar segment-to-segment
-// frictional contact method for large deformations"; benchmarks.md, "3D ironing"):
+// frictional contact method for large deformations"; docs/validation/ironing3d.md):
 // a stiff half-cylindrical die pressed into a soft slab, then dragged along it over
 // about nine master element lengths. Units are consistent but arbitrary (E = 1 for the slab).
 // Dimensions (as published):

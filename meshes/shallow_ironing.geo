@@ -1,4 +1,4 @@
-// Shallow ironing (benchmarks.md, "Shallow ironing"; Yastrebov, "Numerical Methods in
+// Shallow ironing (docs/validation/shallow-ironing.md; Yastrebov, "Numerical Methods in
 // Contact Mechanics"; solids4foam shallowIroning; Kratos shallow_ironing_3D):
 // a stiff indenter with a circular bottom pressed into a soft foundation, then slid.
 // Units: mm, N, MPa. 3D, one element layer of depth 1 in z (plane strain through

@@ -1,5 +1,5 @@
-//! How much a force history oscillates over a sliding phase (benchmarks.md,
-//! "Oscillation metric"): subtract from the force its moving average over one master
+//! How much a force history oscillates over a sliding phase (the metric of
+//! docs/validation/shallow-ironing.md and ironing3d.md): subtract from the force its moving average over one master
 //! element length of travel and measure what is left, relative to the mean force.
 //!
 //! A facet master turns its normal abruptly at every element border, so the force

@@ -2,7 +2,7 @@
 //! ironing3d_frictionless.yaml; mesh meshes/ironing3d.geo) run as shipped, each with
 //! the facet, B-spline [3, 3] and B-spline [4, 4] masters on the same mesh and load
 //! path, and their plot stage. Pinned: the force-history oscillation over the steady
-//! sliding phase (benchmarks.md's metric: RMS about a one-element moving average,
+//! sliding phase (the metric of lib/post/oscillation.rs: RMS about a one-element moving average,
 //! relative to the mean vertical force), the friction ratio, and the Newton
 //! iterations and cutbacks of every master. docs/validation.md, "3D ironing", has
 //! the table these numbers come from.

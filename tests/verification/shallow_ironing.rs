@@ -2,7 +2,7 @@
 //! shallow_ironing_frictionless.yaml; mesh meshes/shallow_ironing.geo) with the cubic
 //! B-spline master (orders [2, 4], the sliding direction cubic), on the published load
 //! path up to t = 1.5: pressed 1 over t ∈ [0, 1], then slid 5 of the published 10 (the
-//! force check of benchmarks.md is at t = 1.5). The test pipeline is the shipped one
+//! force check of the published results is at t = 1.5). The test pipeline is the shipped one
 //! with the [2, 4] chain's stages only, its setup unchanged but `increments` ending at
 //! t = 1.5 with the same step (150 of the 200 increments). Pinned: V(1.5) inside the
 //! published band and to the measured value, H/V (frictionless: H ≈ 0), the
@@ -95,7 +95,7 @@ fn check(name: &str, (r, results): &(History, Results), pin: &Pin) -> (f64, f64)
     let osc = oscillation(&r.s, &r.v, ELEMENT, STEADY.0, STEADY.1).unwrap();
     let (its, cut) = newton_and_cutbacks(results);
     eprintln!("{name}: V(1.5) {v:.2}, H(1.5) {h:.3}, H/V {:.4}, V oscillation {:.3e} (p2p {:.3e}), {its} Newton corrections, {cut} cutbacks", h / v, osc.rms, osc.peak_to_peak);
-    // published at t = 1.5 (six codes, benchmarks.md): V between 337 and 421 N/mm
+    // published at t = 1.5 (six codes, docs/validation/shallow-ironing.md): V between 337 and 421 N/mm
     assert!((337.0..=421.0).contains(&v), "{name}: V(1.5) = {v} outside the published 337–421");
     // 1 %: the mesh, load path and tolerances are fixed (the full pipeline gives the
     // same to 0.1 N/mm); a change of the master's geometry or of the contact element
