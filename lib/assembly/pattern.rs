@@ -312,6 +312,13 @@ impl Pattern {
         self.symbolic.row_idx()
     }
 
+    /// The value slot of the diagonal entry of free dof (column) `j` (rows are sorted
+    /// within a column; every free dof couples with itself, so it is stored).
+    pub fn diagonal_slot(&self, j: usize) -> Option<usize> {
+        let (col_ptr, row_idx) = (self.col_ptr(), self.row_idx());
+        row_idx[col_ptr[j]..col_ptr[j + 1]].binary_search(&j).ok().map(|k| col_ptr[j] + k)
+    }
+
     /// Value slots of hexahedron `e`: 576 entries, column-major, [`NO_SLOT`] for
     /// entries touching a constrained dof.
     pub fn hex_slots(&self, e: usize) -> &[u32] {

@@ -80,7 +80,7 @@ pub fn run(mesh: &Mesh, problem: &Problem, model: &str, setup: &str) -> Result<C
                 .filter(|d| d.pair.slave_nodes.iter().any(on_body) || d.pair.net.nodes.iter().any(on_body))
                 .map(|d| d.pair.name.clone())
                 .collect();
-            BodyModes { name: c.name, nodes: c.nodes.len(), constrained_dofs, centroid: centroid.into(), length, free, contact_pairs }
+            BodyModes { name: c.name, nodes: c.nodes, constrained_dofs, centroid: centroid.into(), length, free, contact_pairs }
         })
         .collect();
     Ok(CheckReport {

@@ -104,7 +104,7 @@ pub fn summary(r: &CheckReport) -> Vec<String> {
                 if b.contact_pairs.is_empty() { " (no contact pair touches it)".to_string() } else { format!(" (contact: {})", b.contact_pairs.join(", ")) }
             )
         };
-        out.push(format!("  {}: {} nodes, {} constrained dofs, centroid ({:.4e}, {:.4e}, {:.4e}): {what}", b.name, b.nodes, b.constrained_dofs, c[0], c[1], c[2]));
+        out.push(format!("  {}: {} nodes, {} constrained dofs, centroid ({:.4e}, {:.4e}, {:.4e}): {what}", b.name, b.nodes.len(), b.constrained_dofs, c[0], c[1], c[2]));
         if b.free.iter().any(|m| m.single().is_none()) {
             out.push(format!("    (a combined mode is a unit vector over the six; rotations in units of 1/L, L = {:.4e})", b.length));
         }

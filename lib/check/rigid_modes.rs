@@ -146,7 +146,8 @@ impl FreeMode {
 #[derive(Debug, Clone, PartialEq)]
 pub struct BodyModes {
     pub name: String,
-    pub nodes: usize,
+    /// Its nodes, sorted.
+    pub nodes: Vec<u32>,
     /// Constrained dofs of the body (fixed or prescribed).
     pub constrained_dofs: usize,
     pub centroid: [f64; 3],

@@ -67,9 +67,26 @@ pub fn reference_gradients(X: &[Vector3<f64>; 8], xi: &[f64; 3]) -> Option<(Shap
     Some((dN * J0inv, det))
 }
 
+/// Volume of a hexahedron (2×2×2 Gauss points, exact for the trilinear map; a
+/// Gauss point with det J ≤ 0 counts nothing).
+pub fn hex8_volume(x: &[Vector3<f64>; 8]) -> f64 {
+    super::quadrature::GAUSS_HEX_2X2X2.iter().map(|xi| reference_gradients(x, xi).map_or(0.0, |(_, det)| det)).sum()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn volume_of_a_sheared_brick() {
+        // the reference element [−1, 1]³ mapped to a 2 × 3 × 0.5 brick, sheared in x
+        let x: [Vector3<f64>; 8] = std::array::from_fn(|a| {
+            let [r, s, t] = HEX8_NODES[a];
+            let (px, py, pz) = (1.0 + r, 1.5 * (1.0 + s), 0.25 * (1.0 + t));
+            Vector3::new(px + 0.4 * pz, py, pz)
+        });
+        assert!((hex8_volume(&x) - 3.0).abs() < 1e-14, "{}", hex8_volume(&x));
+    }
 
     #[test]
     fn kronecker_delta_and_partition_of_unity() {

@@ -36,6 +36,7 @@ use super::problem::Problem;
 use crate::assembly::{Pattern, DOFS_PER_NODE};
 use crate::contact::pair::{PairSolver, SlaveStatus};
 use crate::fem::element::hex8_strain_energy;
+use crate::fem::hex8::hex8_volume;
 
 /// Ratio of dissipated to strain energy above which the log warns (Abaqus' guideline
 /// for its ALLSD/ALLSE).
@@ -108,7 +109,7 @@ impl FreeBodyDamping {
             for (e, hex) in problem.hexes.iter().enumerate() {
                 if member[hex[0] as usize] {
                     g = g.min(crate::material::Material::shear_modulus(&problem.materials[problem.hex_material[e] as usize]));
-                    volume += hex_volume(&hex.map(|a| problem.X[a as usize]));
+                    volume += hex8_volume(&hex.map(|a| problem.X[a as usize]));
                     n_hex += 1;
                 }
             }
@@ -125,19 +126,14 @@ impl FreeBodyDamping {
         Self { bodies: damped, u_n: vec![0.0; DOFS_PER_NODE * n_nodes], scale: 1.0, dissipated_total: 0.0 }
     }
 
-    /// The damped bodies: (name, c, free modes in words are the caller's).
+    /// The damped bodies: (body, c, still damped).
     pub fn bodies(&self) -> impl Iterator<Item = (&FreeBody, f64, bool)> {
         self.bodies.iter().map(|d| (&d.body, d.c, d.active))
     }
 
-    /// The next solve goes to `lambda` from the converged `lambda_n`, in an increment
-    /// planned `planned` long.
-    pub fn predict(&mut self, lambda: f64, lambda_n: f64, planned: Option<f64>) {
-        let step = lambda - lambda_n;
-        self.scale = match planned {
-            Some(p) if step > 0.0 && p > step => p / step,
-            _ => 1.0,
-        };
+    /// The next solve's step is `cutback_ratio` (Δλ̂/Δλ ≥ 1) times shorter than planned.
+    pub fn set_cutback_ratio(&mut self, cutback_ratio: f64) {
+        self.scale = cutback_ratio;
     }
 
     /// Start from the converged state `u` (a restart).
@@ -158,14 +154,11 @@ impl FreeBodyDamping {
 
     /// K_ff += c Δλ̂/Δλ on the diagonal of the damped dofs.
     pub fn add_tangent(&self, pattern: &Pattern, values: &mut [f64]) {
-        let (col_ptr, row_idx, dofs) = (pattern.col_ptr(), pattern.row_idx(), pattern.dofs());
         for b in self.bodies.iter().filter(|b| b.active) {
             let c = self.scale * b.c;
             for &d in &b.dofs {
-                if let Some(j) = dofs.free(d as usize) {
-                    if let Ok(k) = row_idx[col_ptr[j]..col_ptr[j + 1]].binary_search(&j) {
-                        values[col_ptr[j] + k] += c;
-                    }
+                if let Some(slot) = pattern.dofs().free(d as usize).and_then(|j| pattern.diagonal_slot(j)) {
+                    values[slot] += c;
                 }
             }
         }
@@ -253,22 +246,3 @@ fn strain_energy(problem: &Problem, u: &[f64]) -> f64 {
     per_element.iter().sum()
 }
 
-/// Volume of a hexahedron from its 2×2×2 Gauss points.
-fn hex_volume(x: &[Vector3<f64>; 8]) -> f64 {
-    use crate::fem::hex8::reference_gradients;
-    use crate::fem::quadrature::GAUSS_HEX_2X2X2;
-    GAUSS_HEX_2X2X2.iter().map(|xi| reference_gradients(x, xi).map_or(0.0, |(_, det)| det)).sum()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_unit_cube_has_unit_volume() {
-        let x: [Vector3<f64>; 8] = std::array::from_fn(|a| Vector3::new((a & 1) as f64, ((a >> 1) & 1) as f64, ((a >> 2) & 1) as f64));
-        // VTK order: (0,0,0) (1,0,0) (1,1,0) (0,1,0) …
-        let vtk = [x[0], x[1], x[3], x[2], x[4], x[5], x[7], x[6]];
-        assert!((hex_volume(&vtk) - 1.0).abs() < 1e-14);
-    }
-}

@@ -163,8 +163,6 @@ pub struct Newton<'p> {
     /// solve handed to its direct fallback, a correction the penetration step
     /// limit shortened).
     pub notes: Vec<String>,
-    /// Corrections shortened by the penetration step limit (all solves).
-    pub penetration_limits: u32,
     /// The length the schedule planned for the increment being solved (the
     /// stabilisation stiffens when a cutback shortens it).
     pub planned_step: Option<f64>,
@@ -280,7 +278,6 @@ impl<'p> Newton<'p> {
             lambda_n: 0.0,
             frozen_at: None,
             notes: Vec::new(),
-            penetration_limits: 0,
             planned_step: None,
             du_full: vec![0.0; n],
             forcing,
@@ -508,11 +505,12 @@ impl<'p> Newton<'p> {
             u[pr.dof] = p.amplitudes[pr.amplitude as usize].at(lambda) * pr.value;
         }
         p.external_force(lambda, &mut self.f_ext);
+        let ratio = cutback_ratio(self.planned_step, lambda - self.lambda_n);
         if let Some(s) = &mut self.stabilization {
-            s.predict(lambda, self.planned_step);
+            s.predict(lambda, ratio);
         }
         if let Some(f) = &mut self.free_bodies {
-            f.predict(lambda, self.lambda_n, self.planned_step);
+            f.set_cutback_ratio(ratio);
         }
         let ext_norm = self.f_ext.iter().map(|v| v * v).sum::<f64>().sqrt();
         let mut log = Vec::new();
@@ -719,7 +717,6 @@ impl<'p> Newton<'p> {
         }
         let Some((alpha, node, k)) = limit else { return };
         self.r_free.iter_mut().for_each(|d| *d *= alpha);
-        self.penetration_limits += 1;
         let tag = self.problem.node_tags.get(node as usize).copied().unwrap_or(node as u64);
         self.notes.push(format!(
             "iteration {iteration}: correction shortened to {alpha:.3} of its length: slave node {tag} of pair '{}' would have gone more than {depth} master edge lengths past the master",
@@ -742,6 +739,16 @@ impl<'p> Newton<'p> {
                 (name.clone(), f)
             })
             .collect()
+    }
+}
+
+/// How many times shorter than planned the step from the converged λ_n is, Δλ̂/Δλ
+/// (1 for a step as planned or longer, or without a plan): what a cutback does to
+/// the step, by which the stabilisations stiffen.
+fn cutback_ratio(planned: Option<f64>, step: f64) -> f64 {
+    match planned {
+        Some(p) if step > 0.0 && p > step => p / step,
+        _ => 1.0,
     }
 }
 
@@ -803,19 +810,23 @@ impl Partition {
     /// This rank's share of `problem`.
     fn new(problem: &Problem) -> Self {
         let (first, last) = ranks::owned_nodes(problem.n_nodes());
-        let mine = |n: &u32| (*n as usize) >= first && (*n as usize) < last;
-        let hex_ids: Vec<u32> = (0..problem.hexes.len() as u32).filter(|&e| problem.hexes[e as usize].iter().any(mine)).collect();
+        let range = Self { first, last, hex_ids: Vec::new(), hexes: Vec::new() };
+        let hex_ids: Vec<u32> = (0..problem.hexes.len() as u32).filter(|&e| problem.hexes[e as usize].iter().any(|&n| range.owns(n))).collect();
         let hexes = hex_ids.iter().map(|&e| problem.hexes[e as usize]).collect();
-        Self { first, last, hex_ids, hexes }
+        Self { hex_ids, hexes, ..range }
+    }
+
+    /// Whether node `n` is this rank's.
+    fn owns(&self, n: u32) -> bool {
+        (n as usize) >= self.first && (n as usize) < self.last
     }
 
     /// Keeps the groups that touch this rank's nodes (and their owners).
     fn keep_local_groups(&self, groups: &mut NodeGroups, owners: &mut Vec<GroupOwner>) {
-        let mine = |n: &u32| (*n as usize) >= self.first && (*n as usize) < self.last;
         let mut kept = NodeGroups::new();
         let mut kept_owners = Vec::with_capacity(owners.len());
         for (g, nodes) in groups.iter().enumerate() {
-            if nodes.iter().any(mine) {
+            if nodes.iter().any(|&n| self.owns(n)) {
                 kept.push(nodes);
                 kept_owners.push(owners[g]);
             }
@@ -845,7 +856,7 @@ fn contact_groups(p: &Problem, contact: &mut [PairSolver], u: &[f64], groups: &m
         match partition {
             None => pair.search(x)?,
             Some(part) => {
-                let mine = |n: u32| (n as usize) >= part.first && (n as usize) < part.last;
+                let mine = |n: u32| part.owns(n);
                 let mut exchange = |buffer: &mut [f64]| ranks::reduce_over_ranks(buffer, ranks::Reduction::Sum);
                 pair.search_shared(x, Some(SearchShare { mine: &mine, exchange: &mut exchange }))?;
             }
@@ -866,4 +877,20 @@ pub fn gauss_stresses(p: &Problem, u: &[f64]) -> Result<Vec<[[f64; 9]; 8]>, (usi
             Ok(std::array::from_fn(|q| std::array::from_fn(|i| s[q][(i / 3, i % 3)])))
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::cutback_ratio;
+
+    #[test]
+    fn a_cut_back_step_is_shorter_than_planned_by_the_cutback_ratio() {
+        assert_eq!(cutback_ratio(Some(1.0), 0.5), 2.0);
+        assert_eq!(cutback_ratio(Some(0.01), 0.0025), 4.0);
+        // as planned, longer, without a plan, or no step: unchanged
+        assert_eq!(cutback_ratio(Some(1.0), 1.0), 1.0);
+        assert_eq!(cutback_ratio(Some(1.0), 2.0), 1.0);
+        assert_eq!(cutback_ratio(None, 0.5), 1.0);
+        assert_eq!(cutback_ratio(Some(1.0), 0.0), 1.0);
+    }
 }

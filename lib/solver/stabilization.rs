@@ -86,14 +86,10 @@ impl Stabilization {
     }
 
     /// Extrapolate the converged history to the load factor `lambda` of the next solve,
-    /// whose increment was planned `planned` long (`None`: as long as it is).
-    pub fn predict(&mut self, lambda: f64, planned: Option<f64>) {
+    /// whose step is `cutback_ratio` (Δλ̂/Δλ ≥ 1) times shorter than planned.
+    pub fn predict(&mut self, lambda: f64, cutback_ratio: f64) {
         let (u_n, lambda_n) = (&self.last.0, self.last.1);
-        let step = lambda - lambda_n;
-        self.scale = match planned {
-            Some(p) if step > 0.0 && p > step => (p / step).powi(2),
-            _ => 1.0,
-        };
+        self.scale = cutback_ratio.powi(2);
         match &self.before {
             Some((u_b, lambda_b)) if lambda_n > *lambda_b => {
                 let f = (lambda - lambda_n) / (lambda_n - lambda_b);
@@ -127,13 +123,11 @@ impl Stabilization {
 
     /// K_ff += c(Δλ) on the diagonal (`values` in the layout of `pattern`).
     pub fn add_tangent(&self, pattern: &Pattern, values: &mut [f64]) {
-        let (col_ptr, row_idx) = (pattern.col_ptr(), pattern.row_idx());
         for (j, &global) in pattern.dofs().global_of_free().iter().enumerate() {
             let c = self.c[global as usize];
             if c > 0.0 {
-                // rows are sorted within a column; the diagonal is always stored
-                if let Ok(k) = row_idx[col_ptr[j]..col_ptr[j + 1]].binary_search(&j) {
-                    values[col_ptr[j] + k] += self.scale * c;
+                if let Some(slot) = pattern.diagonal_slot(j) {
+                    values[slot] += self.scale * c;
                 }
             }
         }
@@ -174,7 +168,7 @@ mod tests {
         s.last = (u(0.0), 0.0);
         s.commit(&u(0.1), 0.1);
         s.commit(&u(0.15), 0.15);
-        s.predict(0.4, None);
+        s.predict(0.4, 1.0);
         let mut r = vec![0.0; 3];
         s.add_residual(&u(0.4), &mut r);
         assert!(r.iter().all(|v| v.abs() < 1e-12), "{r:?}");
@@ -186,7 +180,7 @@ mod tests {
         let mut s = bare(2, &[(1, 4.0)]);
         s.commit(&[0.0, 1.0], 1.0);
         s.commit(&[0.0, 3.0], 2.0);
-        s.predict(2.5, None); // u_pred = 3 + 0.5 · 2 = 4
+        s.predict(2.5, 1.0); // u_pred = 3 + 0.5 · 2 = 4
         let mut r = vec![0.5, 0.5];
         s.add_residual(&[7.0, 4.5], &mut r);
         // the unstabilised dof keeps its residual; the other gets 4 · (4.5 − 4)
@@ -194,7 +188,7 @@ mod tests {
         assert!((s.forces(&[7.0, 4.5])[0].1 - 2.0).abs() < 1e-12);
         // before the second converged increment: no extrapolation (u_pred = u_n)
         let mut first = bare(2, &[(1, 4.0)]);
-        first.predict(0.3, Some(0.3));
+        first.predict(0.3, 1.0);
         let mut r = vec![0.0; 2];
         first.add_residual(&[0.0, 0.25], &mut r);
         assert_eq!(r, vec![0.0, 1.0]);
@@ -205,8 +199,8 @@ mod tests {
         let mut s = bare(2, &[(1, 4.0)]);
         s.commit(&[0.0, 1.0], 1.0);
         s.commit(&[0.0, 3.0], 2.0);
-        // planned 2 → 3, cut back to 2 → 2.5: c × (1 / 0.5)² = 16; u_pred = 4
-        s.predict(2.5, Some(1.0));
+        // planned 2 → 3, cut back to 2 → 2.5 (ratio 2): c × 2² = 16; u_pred = 4
+        s.predict(2.5, 2.0);
         assert_eq!(s.scale(), 4.0);
         let mut r = vec![0.0; 2];
         s.add_residual(&[0.0, 4.5], &mut r);
@@ -218,14 +212,12 @@ mod tests {
         let pattern = crate::assembly::Pattern::build(dofs, &hexes, crate::assembly::NodeGroups::new()).unwrap();
         let mut big = bare(3 * nodes.len(), &[(1, 4.0)]);
         big.commit(&vec![0.0; 3 * nodes.len()], 1.0);
-        big.predict(1.25, Some(1.0));
+        big.predict(1.25, 4.0);
         let mut values = vec![0.0; pattern.nnz()];
         big.add_tangent(&pattern, &mut values);
         assert_eq!(values.iter().sum::<f64>(), 16.0 * 4.0);
-        // a step as planned, or longer, keeps c
-        s.predict(3.0, Some(1.0));
-        assert_eq!(s.scale(), 1.0);
-        s.predict(2.5, None);
+        // a step as planned keeps c
+        s.predict(3.0, 1.0);
         assert_eq!(s.scale(), 1.0);
     }
 }

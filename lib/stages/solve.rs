@@ -136,13 +136,9 @@ pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, 
     if !free.is_empty() {
         let beta = setup.newton.free_body_damping;
         if beta > 0.0 {
-            let components = crate::check::rigid_modes::components(&mesh);
             let bodies = free
                 .iter()
-                .filter_map(|b| {
-                    let c = components.iter().find(|c| c.name == b.name)?;
-                    Some(FreeBody { name: b.name.clone(), nodes: c.nodes.clone(), free: b.free.iter().map(|m| m.0).collect(), centroid: b.centroid.into(), length: b.length })
-                })
+                .map(|b| FreeBody { name: b.name.clone(), nodes: b.nodes.clone(), free: b.free.iter().map(|m| m.0).collect(), centroid: b.centroid.into(), length: b.length })
                 .collect();
             newton.damp_free_bodies(bodies, beta);
             if let Some(f) = &newton.free_bodies {
