@@ -364,14 +364,19 @@ impl<'p> Newton<'p> {
     }
 
     /// Continue from the converged increments of a results file: the stabilisation
-    /// takes the last two states (its extrapolation), every pair its multipliers and
-    /// friction history, and the contact search runs at the last state, so the next
-    /// increment starts where the interrupted run would have.
+    /// takes the last two states (its extrapolation), the free bodies' damping the
+    /// last one (its work counts from here: the read-back increments are not damped
+    /// motion), every pair its multipliers and friction history, and the contact
+    /// search runs at the last state, so the next increment starts where the
+    /// interrupted run would have.
     /// `increments` are the converged ones read back (at least one).
     pub fn resume(&mut self, increments: &[Increment]) -> Result<(), IncrementFailure> {
         let tail = &increments[increments.len().saturating_sub(2)..];
         for inc in tail {
-            self.commit_increment(&inc.displacements(), inc.info.load_factor);
+            if let Some(s) = &mut self.stabilization {
+                s.commit(&inc.displacements(), inc.info.load_factor);
+            }
+            self.lambda_n = inc.info.load_factor;
         }
         if let (Some(f), Some(last)) = (&mut self.free_bodies, tail.last()) {
             f.restart_from(&last.displacements());

@@ -414,3 +414,39 @@ fn a_floating_block_is_damped_until_contact_holds_it() {
         }
     }
 }
+
+/// A damped run continued from its results file (`--restart`): the damping counts
+/// its work from the restart, the read-back increment is not damped motion, and the
+/// continued increment does the uninterrupted run's work. (Committing the
+/// read-back increments as solved ones added their whole displacement, from zero,
+/// to the work.)
+#[test]
+fn a_restarted_damped_run_counts_its_work_from_the_restart() {
+    let dir = tempdir();
+    let d = dir.path();
+    write_model(d, &stacked(|_| 0.0), "lower_z1", false);
+    let base = setup("eps_n: 1.0e4, enforcement: penalty", true, 0.001) + "newton: {free_body_damping: 1.0e-3}\n";
+    let whole = base.replace("increments: {count: 1, max_cutbacks: 0}", "increments: {count: 2, max_cutbacks: 0}");
+    let half = base.replace("increments: {count: 1, max_cutbacks: 0}", "increments: {factors: [0.5], max_cutbacks: 0}");
+    std::fs::write(d.join("whole.yaml"), whole).unwrap();
+    std::fs::write(d.join("half.yaml"), half).unwrap();
+    // (work in this increment, work in all) of increment `k`/2
+    let work = |err: &str, k: usize| -> (f64, f64) {
+        let l = err.lines().find(|l| l.starts_with(&format!("increment {k}/2: free-body damping dissipated"))).unwrap_or_else(|| panic!("increment {k}:\n{err}"));
+        let num = |after: &str| l.split(after).nth(1).and_then(|r| r.split(' ').next()).and_then(|r| r.parse::<f64>().ok()).unwrap_or_else(|| panic!("{l}"));
+        (num("dissipated "), num("in this increment, "))
+    };
+    let o = run("sc-solve", &["m.sccontact", "--setup", "whole.yaml", "-o", "whole.scres"], d);
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    let uninterrupted = work(&err, 2);
+    let o = run("sc-solve", &["m.sccontact", "--setup", "half.yaml", "-o", "half.scres"], d);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = run("sc-solve", &["m.sccontact", "--setup", "whole.yaml", "-o", "continued.scres", "--restart", "half.scres"], d);
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    let (this, all) = work(&err, 2);
+    assert!(this > 0.0 && (this / uninterrupted.0 - 1.0).abs() < 1e-9, "continued {this:e}, uninterrupted {:e}", uninterrupted.0);
+    assert_eq!(this, all, "the work counts from the restart:\n{err}");
+}
+
