@@ -8,6 +8,8 @@
 //! | [`element`]   | one slave node against the master: g_N, t_N, residual and tangent (eqs. 4.2–4.3, 6.2–6.5) |
 //! | [`friction`]  | Coulomb friction of one slave node: trial traction, return mapping (eqs. 4.5–4.9) |
 //! | [`dual`]      | forward-mode dual numbers, for the exact frictional tangent |
+//! | [`master`]    | the master surface behind one projection interface (B-spline or facets) |
+//! | [`mortar`]    | segment-to-segment integration of the constraint over the slave faces (`integration: mortar`) |
 //! | [`pair`]      | one pair during the solve: search, active set, Uzawa updates |
 //! | [`adjust`]    | slave nodes moved onto the master before the first increment (stress-free) |
 
@@ -15,6 +17,8 @@ pub mod adjust;
 pub mod dual;
 pub mod element;
 pub mod friction;
+pub mod master;
+pub mod mortar;
 pub mod net;
 pub mod pair;
 pub mod tributary;

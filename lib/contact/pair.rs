@@ -23,7 +23,10 @@ use super::element::{normal_contact, ContactElementError, NormalLaw};
 use super::friction::{friction_state, frictional_contact, FrictionLaw};
 use crate::format::sccontact::MasterKind;
 use crate::solver::problem::ContactDefinition;
-use crate::format::setup::Enforcement;
+use crate::format::setup::{Enforcement, Integration};
+use super::master::Projector;
+use super::mortar::element::mortar_contact;
+use super::mortar::{Mortar, MortarError};
 use crate::spline::{BSplinePatch, BSplineProjector, FacetProjector, FacetSurface, Projection, SplineError, SurfacePoint, Vec3};
 
 /// Settings of a pair, resolved (absolute lengths).
@@ -42,6 +45,8 @@ pub struct PairSettings {
     /// Master-surface stabilisation factor η (0: off): an artificial inertia of
     /// stiffness η ε_N Ā_s on the master net's nodes (`solver::stabilization`).
     pub stabilization: f64,
+    /// Node-to-surface or mortar (`contact::mortar`).
+    pub integration: Integration,
 }
 
 impl PairSettings {
@@ -68,61 +73,6 @@ impl SlaveStatus {
             Self::Outside => -1.0,
             Self::Open => 0.0,
             Self::Active => 1.0,
-        }
-    }
-}
-
-/// The master as the projection sees it.
-enum Projector {
-    BSpline(BSplineProjector),
-    Facet(FacetProjector),
-}
-
-impl Projector {
-    fn update(&mut self, x: &[Vec3]) -> Result<(), SplineError> {
-        match self {
-            Self::BSpline(p) => p.update(x),
-            Self::Facet(p) => p.update(x),
-        }
-    }
-    /// The projection and, for facets, the cell it lies on (kept from `prev` at ties).
-    fn project(&self, p: &Vec3, prev: Option<[usize; 2]>) -> (Projection, Option<[usize; 2]>) {
-        match self {
-            Self::BSpline(pr) => (pr.project(p), None),
-            Self::Facet(pr) => {
-                let (proj, cell) = pr.project_keeping(p, prev);
-                (proj, Some(cell))
-            }
-        }
-    }
-    /// With the master element held (a frozen search): a facet slave projects onto
-    /// its last cell's continued bilinear map, a slave in crease contact onto the same
-    /// crease (`last`: its previous projection); a B-spline slave as usual (the patch
-    /// is one smooth map, there is no element to hold).
-    fn project_frozen(&self, p: &Vec3, prev: Option<[usize; 2]>, last: &Projection) -> (Projection, Option<[usize; 2]>) {
-        match (self, prev) {
-            (Self::Facet(pr), Some(c)) => {
-                let crease = [0, 1].map(|al| last.clamped[al].then_some(last.xi[al]));
-                let (proj, cell) = pr.project_on_cell(p, c, crease);
-                (proj, Some(cell))
-            }
-            _ => self.project(p, prev),
-        }
-    }
-    /// The closest point on the surface's extension beyond its edge (see
-    /// [`BSplineProjector::project_extended`]).
-    fn project_extended(&self, p: &Vec3, xi0: [f64; 2], cell: Option<[usize; 2]>, margin: [f64; 2]) -> Projection {
-        match (self, cell) {
-            (Self::BSpline(pr), _) => pr.project_extended(p, xi0, margin),
-            (Self::Facet(pr), Some(c)) => pr.project_extended(p, c, margin),
-            (Self::Facet(pr), None) => pr.project(p),
-        }
-    }
-    fn evaluate(&self, xi: [f64; 2], cell: Option<[usize; 2]>) -> SurfacePoint {
-        match (self, cell) {
-            (Self::BSpline(p), _) => p.evaluate(xi),
-            (Self::Facet(p), Some(c)) => p.evaluate_in_cell(xi, c),
-            (Self::Facet(p), None) => p.evaluate(xi),
         }
     }
 }
@@ -167,6 +117,8 @@ fn project_slave(projector: &Projector, frozen: bool, edge_tolerance: f64, xs: &
 pub enum PairError {
     #[error("contact pair '{pair}': master surface: {source}")]
     Master { pair: String, source: SplineError },
+    #[error("contact pair '{pair}': {source}")]
+    Mortar { pair: String, source: MortarError },
     #[error("contact pair '{pair}': exchanging the search results between MPI ranks: {message}")]
     Exchange { pair: String, message: String },
 }
@@ -275,6 +227,8 @@ pub struct PairSolver {
     pub slave_force: Vec<Vec3>,
     /// The buffer of a shared search (storage reused).
     exchange: Vec<f64>,
+    /// `integration: mortar`: the segment-to-segment integration of the gaps.
+    mortar: Option<Mortar>,
 }
 
 /// A snapshot of the multipliers an Uzawa update sets ([`PairSolver::multipliers`]).
@@ -318,6 +272,14 @@ impl PairSolver {
         let settings = def.settings;
         let areas = def.areas.clone();
         let n = pair.slave_nodes.len();
+        let mortar = match settings.integration {
+            Integration::Node => None,
+            Integration::Mortar => Some(
+                Mortar::new(&def.slave_faces, &pair.slave_nodes, x_ref, [a, b], &pair.net.nodes)
+                    .map_err(err)?
+                    .map_err(|source| PairError::Mortar { pair: pair.name.clone(), source })?,
+            ),
+        };
         Ok(Self {
             name: pair.name.clone(),
             settings,
@@ -351,6 +313,7 @@ impl PairSolver {
             slipping: vec![false; n],
             slave_force: vec![Vec3::zeros(); n],
             exchange: Vec::new(),
+            mortar,
         })
     }
 
@@ -415,6 +378,9 @@ impl PairSolver {
                         sp.hold_on_crease(xs, proj.clamped);
                     }
                 });
+        }
+        if let Some(mortar) = &mut self.mortar {
+            mortar.integrate(&self.projector, &self.x_net, &self.x_slave, &self.projections, &self.areas).map_err(|source| PairError::Master { pair: self.name.clone(), source })?;
         }
         for s in 0..self.slaves.len() {
             if self.xi_n[s][0].is_nan() && self.usable(s) {
@@ -485,9 +451,25 @@ impl PairSolver {
     /// and then on the patch's extension (see [`Self::search`]): a slave edge flush
     /// with the master edge must not flicker in and out of contact by round-off or by
     /// a lateral strain difference.
+    ///
+    /// Under mortar integration: some quadrature point of the node's faces lies over
+    /// the master (and the node's own projection converged, for its contact frame).
     pub fn usable(&self, s: usize) -> bool {
         let p = &self.projections[s];
-        p.inside && p.converged && self.points[s].n_bar.iter().all(|v| v.is_finite())
+        let inside = match &self.mortar {
+            Some(m) => m.covered[s] > 0.0,
+            None => p.inside,
+        };
+        inside && p.converged && self.points[s].n_bar.iter().all(|v| v.is_finite())
+    }
+
+    /// The gap of slave `s` at the last search: g_N of its projection (eq. 4.3), or
+    /// the weighted gap ĝ_s under mortar integration.
+    pub fn gap(&self, s: usize) -> f64 {
+        match &self.mortar {
+            Some(m) => m.gap[s],
+            None => self.projections[s].g,
+        }
     }
 
     /// The closest-point projection of slave `s` at the last search and the master
@@ -511,7 +493,12 @@ impl PairSolver {
     /// tells `owner` its slave index.
     pub fn push_groups(&self, groups: &mut crate::assembly::NodeGroups, mut owner: impl FnMut(usize)) {
         for s in 0..self.slaves.len() {
-            if !self.usable(s) || (self.projections[s].g >= self.capture && self.lambda_n[s] >= 0.0) {
+            if !self.usable(s) || (self.gap(s) >= self.capture && self.lambda_n[s] >= 0.0) {
+                continue;
+            }
+            if let Some(m) = &self.mortar {
+                groups.push_iter(m.element_nodes(s).iter().copied());
+                owner(s);
                 continue;
             }
             groups.push_iter(std::iter::once(self.slaves[s]).chain(self.points[s].basis.nodes().iter().map(|&k| self.net[k])));
@@ -521,7 +508,7 @@ impl PairSolver {
 
     /// λ_N + ε_N g_N of slave `s` at the last search (eq. 4.2): pressed when < 0.
     fn trial(&self, s: usize) -> f64 {
-        self.lambda_n[s] + self.settings.eps_n * self.projections[s].g
+        self.lambda_n[s] + self.settings.eps_n * self.gap(s)
     }
 
     /// Inside the patch and pressed into it at the last search.
@@ -541,6 +528,9 @@ impl PairSolver {
 
     /// The contact element of slave `s` (group nodes `[slave, control points]`).
     pub fn element(&self, s: usize, r: &mut DVector<f64>, k: &mut DMatrix<f64>) -> Result<(), ContactElementError> {
+        if let Some(m) = &self.mortar {
+            return mortar_contact(m, s, &self.projector, &self.x_slave, &self.normal_law(s), r, k).map(|_| ());
+        }
         if self.settings.frictional() {
             frictional_contact(&self.x_slave[s], &self.points[s], &self.normal_law(s), &self.friction_law(s), r, k).map(|_| ())
         } else {
@@ -564,6 +554,10 @@ impl PairSolver {
             let trial = self.trial(s);
             self.t_n[s] = trial.min(0.0);
             self.status[s] = if trial < 0.0 { SlaveStatus::Active } else { SlaveStatus::Open };
+            if let (Some(m), true) = (&self.mortar, trial < 0.0) {
+                self.slave_force[s] = m.slave_force(s, &self.projector) * (-self.t_n[s]);
+                continue;
+            }
             if trial < 0.0 {
                 self.slave_force[s] = self.points[s].n_bar * (-self.t_n[s] * self.areas[s]);
                 if self.settings.frictional() {
@@ -652,7 +646,7 @@ impl PairSolver {
 
     /// Largest penetration −g_N over the active slaves (0 if none).
     pub fn max_penetration(&self) -> f64 {
-        (0..self.slaves.len()).filter(|&s| self.status[s] == SlaveStatus::Active).map(|s| -self.projections[s].g).fold(0.0, f64::max)
+        (0..self.slaves.len()).filter(|&s| self.status[s] == SlaveStatus::Active).map(|s| -self.gap(s)).fold(0.0, f64::max)
     }
 
     /// The fraction α ∈ (0, 1] of a Newton correction `du(node)` that carries no
@@ -839,8 +833,8 @@ mod tests {
             slave_nodes: (30..70).collect(),
             net: ControlNet { a, b, nodes: (0..30).collect() },
         };
-        let settings = PairSettings { eps_n: 1e3, enforcement: Enforcement::Penalty, penetration_tolerance: 1e-3, max_augmentations: 0, update_halvings: 0, mu: 0.0, eps_t: 0.0, stabilization: 0.0 };
-        let def = ContactDefinition { pair, settings, areas: vec![0.01; 40], h_master: 0.2, eps_n_default: false, adjust: None, allow_flipped_master: false };
+        let settings = PairSettings { eps_n: 1e3, enforcement: Enforcement::Penalty, penetration_tolerance: 1e-3, max_augmentations: 0, update_halvings: 0, mu: 0.0, eps_t: 0.0, stabilization: 0.0, integration: Integration::Node };
+        let def = ContactDefinition { pair, settings, areas: vec![0.01; 40], slave_faces: Vec::new(), h_master: 0.2, eps_n_default: false, adjust: None, allow_flipped_master: false };
         let solver = PairSolver::new(&def, &x).unwrap();
         (x, solver)
     }

@@ -420,6 +420,20 @@ pub enum Enforcement {
     AugmentedLagrangian,
 }
 
+/// Where a pair's normal constraint is imposed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum Integration {
+    /// At the slave nodes, one closest-point projection each (the paper's
+    /// node-to-surface method, eqs. 2.2, 6.2).
+    #[default]
+    Node,
+    /// Integrated over the slave faces, segment by segment against the master cells,
+    /// with multipliers at the slave nodes (`contact::mortar`): passes the contact
+    /// patch test. Frictionless pairs with a face-set slave.
+    Mortar,
+}
+
 /// Contact settings of one pair of the `.sccontact` model (by its name).
 #[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
@@ -433,6 +447,9 @@ pub struct ContactSetup {
     pub eps_n: Option<f64>,
     #[serde(default)]
     pub enforcement: Enforcement,
+    /// Where the constraint is imposed: `node` (default) or `mortar`.
+    #[serde(default, skip_serializing_if = "is_node")]
+    pub integration: Integration,
     /// Largest accepted penetration −g_N (a length), augmented Lagrangian only.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub penetration_tolerance: Option<f64>,
@@ -468,6 +485,10 @@ pub struct ContactSetup {
     /// (`check::orientation`); without it such a pair is refused.
     #[serde(default, skip_serializing_if = "is_false")]
     pub allow_flipped_master: bool,
+}
+
+fn is_node(v: &Integration) -> bool {
+    *v == Integration::Node
 }
 
 fn is_false(v: &bool) -> bool {

@@ -12,9 +12,9 @@ use crate::assembly::{DofMap, DOFS_PER_NODE};
 use crate::contact::adjust::{adjust_pair, AdjustError, PairAdjustment};
 use crate::contact::pair::PairSettings;
 use crate::contact::tributary::tributary_areas;
-use crate::format::sccontact::{ContactPair, SlaveKind};
+use crate::format::sccontact::{ContactPair, MasterKind, SlaveKind};
 use crate::fem::element::Formulation;
-use crate::format::setup::{self, ModelName, SolveSetup};
+use crate::format::setup::{self, Integration, ModelName, SolveSetup};
 use crate::material::linear::LinearElastic;
 use crate::material::neo_hookean::{CiarletSimo, DevVolNeoHookean};
 use crate::material::{MaterialError, MaterialModel};
@@ -65,6 +65,8 @@ pub struct ContactDefinition {
     pub settings: PairSettings,
     /// Tributary area of each slave node (eq. 6.1), order of `pair.slave_nodes`.
     pub areas: Vec<f64>,
+    /// The slave faces (mesh node ids, cycle order; empty for a node-set slave).
+    pub slave_faces: Vec<[u32; 4]>,
     /// Mean edge length of the master net (reference configuration).
     pub h_master: f64,
     /// ε_N was not given: [`default_penalty`].
@@ -73,6 +75,18 @@ pub struct ContactDefinition {
     pub adjust: Option<f64>,
     /// The setup accepts a master whose normal points away from the slave body.
     pub allow_flipped_master: bool,
+}
+
+impl ContactDefinition {
+    /// Whether the pair's contact tangent is symmetric: frictionless, and the master
+    /// virtual displacement the variation of its geometry (node-to-surface; mortar
+    /// with facets or a bilinear patch, whose trace is the surface itself). Slip, and
+    /// a mortar pair's B-spline master of order ≥ 3 (geometry from the patch, forces
+    /// through the facet trace, `contact::mortar`) make it non-symmetric.
+    pub fn symmetric_tangent(&self) -> bool {
+        let trace_is_geometry = self.pair.master_kind == MasterKind::Facet || self.pair.orders == [2, 2];
+        !self.settings.frictional() && (self.settings.integration == Integration::Node || trace_is_geometry)
+    }
 }
 
 /// The problem.
@@ -188,6 +202,18 @@ fn contact_definitions(mesh: &Mesh, pairs: &[ContactPair], setup: &SolveSetup, f
                 return Err(bad(format!("adjust must be a length ≥ 0 (0: off), found {d}")));
             }
         }
+        let slave_faces: Vec<[u32; 4]> = match (pair.slave_kind, mesh.face_set(&pair.slave)) {
+            (SlaveKind::FaceSet, Some(fs)) => fs.faces.iter().map(|&f| mesh.face_nodes(f)).collect(),
+            _ => Vec::new(),
+        };
+        if c.integration == Integration::Mortar {
+            if slave_faces.is_empty() {
+                return Err(bad(format!("integration: mortar integrates over the slave faces, but slave '{}' is a node set; give the slave as a face set (sc-tag) or use integration: node", pair.slave)));
+            }
+            if c.mu > 0.0 {
+                return Err(bad("integration: mortar is frictionless for now (mu must be 0); use integration: node for Coulomb friction".into()));
+            }
+        }
         let areas = tributary_areas(mesh, &pair.slave_nodes, (pair.slave_kind == SlaveKind::FaceSet).then_some(pair.slave.as_str()));
         let penetration_tolerance = match (c.penetration_tolerance, c.penetration_tolerance_relative) {
             (Some(_), Some(_)) => return Err(bad("give `penetration_tolerance` or `penetration_tolerance_relative`, not both".into())),
@@ -197,9 +223,10 @@ fn contact_definitions(mesh: &Mesh, pairs: &[ContactPair], setup: &SolveSetup, f
         };
         out.push(ContactDefinition {
             pair: pair.clone(),
-            settings: PairSettings { eps_n, enforcement: c.enforcement, penetration_tolerance, max_augmentations: c.max_augmentations, update_halvings: c.update_halvings, mu: c.mu, eps_t, stabilization: c.stabilization },
+            settings: PairSettings { eps_n, enforcement: c.enforcement, penetration_tolerance, max_augmentations: c.max_augmentations, update_halvings: c.update_halvings, mu: c.mu, eps_t, stabilization: c.stabilization, integration: c.integration },
             eps_n_default,
             areas,
+            slave_faces,
             h_master: h,
             adjust: c.adjust.filter(|&d| d != 0.0),
             allow_flipped_master: c.allow_flipped_master,
@@ -445,9 +472,9 @@ impl Problem {
         (X, ue)
     }
 
-    /// True if the tangent is symmetric: no follower pressure and no friction
-    /// (frictionless contact keeps it symmetric; slip makes it non-symmetric).
+    /// True if the tangent is symmetric: no follower pressure and every contact
+    /// pair's tangent symmetric ([`ContactDefinition::symmetric_tangent`]).
     pub fn symmetric(&self) -> bool {
-        self.pressure_faces.is_empty() && self.contact.iter().all(|c| !c.settings.frictional())
+        self.pressure_faces.is_empty() && self.contact.iter().all(ContactDefinition::symmetric_tangent)
     }
 }
