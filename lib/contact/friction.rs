@@ -114,29 +114,75 @@ pub fn frictional_contact(
     r: &mut DVector<f64>,
     k: &mut DMatrix<f64>,
 ) -> Result<FrictionState, ContactElementError> {
-    evaluate(xs, sp, normal, friction, r, Some(k))
+    evaluate(xs, sp, normal, friction, None, r, Some(k), None)
+}
+
+/// The tangential part alone, for a normal pressure `t_n` (< 0) that comes from
+/// elsewhere (the weighted gap of mortar integration, `super::mortar`): the friction
+/// residual `r = A_s t_Tα δξ̄^α` over `[x_s; x_A]`, its tangent with t_N held, and
+/// `dr_dtn = ∂r/∂t_N` (nonzero in slip, where μ|t_N| bounds t_T), which the caller
+/// chains with t_N's own gradient. `normal` gives A_s (λ_N, ε_N are not used). Zero
+/// when `t_n ≥ 0`.
+#[allow(clippy::too_many_arguments)]
+pub fn tangential_contact(
+    xs: &Vec3,
+    sp: &SurfacePoint,
+    t_n: f64,
+    normal: &NormalLaw,
+    friction: &FrictionLaw,
+    r: &mut DVector<f64>,
+    k: &mut DMatrix<f64>,
+    dr_dtn: &mut DVector<f64>,
+) -> Result<FrictionState, ContactElementError> {
+    evaluate(xs, sp, normal, friction, Some(t_n), r, Some(k), Some(dr_dtn))
+}
+
+/// [`tangential_contact`]'s state alone (t_Tα, stick/slip, the tangential force on
+/// the slave node).
+pub fn tangential_state(xs: &Vec3, sp: &SurfacePoint, t_n: f64, normal: &NormalLaw, friction: &FrictionLaw) -> Result<FrictionState, ContactElementError> {
+    let mut r = DVector::zeros(3 * (1 + sp.basis.len()));
+    evaluate(xs, sp, normal, friction, Some(t_n), &mut r, None, None)
 }
 
 /// The state alone (t_N, t_Tα, stick/slip, the force on the slave), without the
 /// tangent: for the converged-state output.
 pub fn friction_state(xs: &Vec3, sp: &SurfacePoint, normal: &NormalLaw, friction: &FrictionLaw) -> Result<FrictionState, ContactElementError> {
     let mut r = DVector::zeros(3 * (1 + sp.basis.len()));
-    evaluate(xs, sp, normal, friction, &mut r, None)
+    evaluate(xs, sp, normal, friction, None, &mut r, None, None)
 }
 
+/// The element, by dual numbers. `given_t_n`: the tangential part alone for that
+/// normal pressure (see [`tangential_contact`]); then `dr_dtn` receives ∂r/∂t_N.
+#[allow(clippy::too_many_arguments)]
 fn evaluate(
     xs: &Vec3,
     sp: &SurfacePoint,
     normal: &NormalLaw,
     friction: &FrictionLaw,
+    given_t_n: Option<f64>,
     r: &mut DVector<f64>,
     mut k: Option<&mut DMatrix<f64>>,
+    mut dr_dtn: Option<&mut DVector<f64>>,
 ) -> Result<FrictionState, ContactElementError> {
     let nc = sp.basis.len();
     let m = 3 * (1 + nc);
     let g0 = (xs - sp.x_bar).dot(&sp.n_bar);
     let crease = sp.on_crease();
-    if normal.lambda_n + normal.eps_n * g0 >= 0.0 || friction.mu == 0.0 && friction.eps_t == 0.0 && !crease {
+    if let Some(t) = given_t_n {
+        if r.len() != m {
+            *r = DVector::zeros(m);
+        }
+        r.fill(0.0);
+        if let Some(k) = k.as_deref_mut() {
+            *k = DMatrix::zeros(m, m);
+        }
+        if let Some(d) = dr_dtn.as_deref_mut() {
+            *d = DVector::zeros(m);
+        }
+        if t >= 0.0 || friction.mu == 0.0 && friction.eps_t == 0.0 {
+            return Ok(FrictionState { g_n: g0, t_n: t.min(0.0), active: t < 0.0, t_t: [0.0; 2], t_t_vector: Vec3::zeros(), slip: false, slave_force: Vec3::zeros() });
+        }
+    } else if normal.lambda_n + normal.eps_n * g0 >= 0.0 || friction.mu == 0.0 && friction.eps_t == 0.0 && !crease {
         let mut scratch = DMatrix::zeros(0, 0);
         let st = normal_contact(xs, sp, normal, r, k.unwrap_or(&mut scratch))?;
         let slave_force = -Vec3::new(r[0], r[1], r[2]);
@@ -169,8 +215,10 @@ fn evaluate(
         }
     }
     let mut state = None;
-    for j in first..=m {
-        // j < m: seed direction e_j; j = m: values only (the residual and the state)
+    // j < m: seed direction e_j; j = m: values only (the residual and the state);
+    // j = m + 1 (a given t_N with dr_dtn): seed t_N alone
+    let last = if given_t_n.is_some() && dr_dtn.is_some() { m + 1 } else { m };
+    for j in first..=last {
         let (slave_dir, master_dir) = if j < 3 {
             (Some(j), None)
         } else if j < m {
@@ -215,8 +263,13 @@ fn evaluate(
         let a_t = if crease_friction { [0, 1].map(|al| sub(&a_al[al], &scale(&n, dot(&a_al[al], &n)))) } else { a_al };
         let met = [[dot(&a_t[0], &a_t[0]), dot(&a_t[0], &a_t[1])], [dot(&a_t[1], &a_t[0]), dot(&a_t[1], &a_t[1])]];
         let met_inv = inv2(met).ok_or(ContactElementError::FocalPoint { g_n: g0 })?;
-        // normal law (eq. 4.2)
-        let t_n = Dual::cst(normal.lambda_n) + g * normal.eps_n;
+        // normal law (eq. 4.2), or the given pressure
+        let t_n = match given_t_n {
+            Some(t) => Dual::new(t, if j == m + 1 { 1.0 } else { 0.0 }),
+            None => Dual::cst(normal.lambda_n) + g * normal.eps_n,
+        };
+        // the normal part of r (a given pressure: the caller's)
+        let t_nn = if given_t_n.is_some() { Dual::ZERO } else { t_n };
         // trial tangential traction and return mapping (eqs. 4.6–4.8)
         let xi = [Dual::new(sp.xi[0], dxi[0]), Dual::new(sp.xi[1], dxi[1])];
         let slip_xi = [xi[0] - Dual::cst(friction.xi_n[0]), xi[1] - Dual::cst(friction.xi_n[1])];
@@ -244,18 +297,20 @@ fn evaluate(
                 if let Some(k) = k.as_deref_mut() {
                     k[(i, j)] = v.d * area;
                 }
-            } else {
+            } else if j == m {
                 r[i] = v.v * area;
+            } else if let Some(d) = dr_dtn.as_deref_mut() {
+                d[i] = v.d * area;
             }
         };
         // slave block: N_s = n̄, T_β,s = ā_β
         for c in 0..3 {
-            put(c, t_n * n[c] + t_vec[c]);
+            put(c, t_nn * n[c] + t_vec[c]);
         }
         // control point A: N_A = −Q_A n̄, T_β,A = −Q_A ā_β
         for (a, &q_a) in qd.iter().enumerate().take(nc) {
             for c in 0..3 {
-                put(3 * (1 + a) + c, -q_a * (t_n * n[c] + t_vec[c]));
+                put(3 * (1 + a) + c, -q_a * (t_nn * n[c] + t_vec[c]));
             }
         }
         if j == m {

@@ -20,12 +20,12 @@ use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 
 use super::element::{normal_contact, ContactElementError, NormalLaw};
-use super::friction::{friction_state, frictional_contact, FrictionLaw};
+use super::friction::{friction_state, frictional_contact, tangential_state, FrictionLaw};
 use crate::format::sccontact::MasterKind;
 use crate::solver::problem::ContactDefinition;
 use crate::format::setup::{Enforcement, Integration};
 use super::master::Projector;
-use super::mortar::element::mortar_contact;
+use super::mortar::element::{mortar_contact, NodeFriction};
 use super::mortar::{Mortar, MortarError};
 use crate::spline::{BSplinePatch, BSplineProjector, FacetProjector, FacetSurface, Projection, SplineError, SurfacePoint, Vec3};
 
@@ -380,7 +380,7 @@ impl PairSolver {
                 });
         }
         if let Some(mortar) = &mut self.mortar {
-            mortar.integrate(&self.projector, &self.x_net, &self.x_slave, &self.projections, &self.areas).map_err(|source| PairError::Master { pair: self.name.clone(), source })?;
+            mortar.integrate(&self.projector, &self.x_net, &self.x_slave, &self.projections, &self.points, &self.areas).map_err(|source| PairError::Master { pair: self.name.clone(), source })?;
         }
         for s in 0..self.slaves.len() {
             if self.xi_n[s][0].is_nan() && self.usable(s) {
@@ -410,9 +410,9 @@ impl PairSolver {
         if self.settings.frictional() {
             for s in 0..self.slaves.len() {
                 self.held_slip[s] = None;
-                if self.pressed(s) {
-                    let law = FrictionLaw { held_slip: None, ..self.friction_law(s) };
-                    if let Ok(st) = friction_state(&self.x_slave[s], &self.points[s], &self.normal_law(s), &law) {
+                if self.pressed(s) && (self.mortar.is_none() || self.mortar_friction(s)) {
+                    self.held_slip[s] = None;
+                    if let Ok(st) = self.node_friction_state(s) {
                         self.held_slip[s] = Some(st.slip);
                     }
                 }
@@ -526,10 +526,29 @@ impl PairSolver {
         FrictionLaw { mu: self.settings.mu, eps_t: self.settings.eps_t, xi_n: self.xi_n[s], t_t_n: self.t_t_n[s], held_slip: self.held_slip[s] }
     }
 
+    /// Under mortar integration, whether slave `s` carries friction at its node: a
+    /// frictional pair and the node's own foot point inside the master (where the
+    /// closest-point conditions, and so the convective slip, hold).
+    fn mortar_friction(&self, s: usize) -> bool {
+        self.mortar.is_some() && self.settings.frictional() && self.projections[s].inside && self.projections[s].converged
+    }
+
+    /// The friction state of slave `s` at the last search (the return mapping,
+    /// without the tangent): node-to-surface, or at the node with the mortar pressure.
+    fn node_friction_state(&self, s: usize) -> Result<crate::contact::friction::FrictionState, ContactElementError> {
+        if self.mortar.is_some() {
+            tangential_state(&self.x_slave[s], &self.points[s], self.trial(s).min(0.0), &self.normal_law(s), &self.friction_law(s))
+        } else {
+            friction_state(&self.x_slave[s], &self.points[s], &self.normal_law(s), &self.friction_law(s))
+        }
+    }
+
     /// The contact element of slave `s` (group nodes `[slave, control points]`).
     pub fn element(&self, s: usize, r: &mut DVector<f64>, k: &mut DMatrix<f64>) -> Result<(), ContactElementError> {
         if let Some(m) = &self.mortar {
-            return mortar_contact(m, s, &self.projector, &self.x_slave, &self.normal_law(s), r, k).map(|_| ());
+            let law = self.friction_law(s);
+            let friction = self.mortar_friction(s).then_some(NodeFriction { foot: &self.points[s], law: &law });
+            return mortar_contact(m, s, &self.projector, &self.x_slave, &self.normal_law(s), friction, r, k).map(|_| ());
         }
         if self.settings.frictional() {
             frictional_contact(&self.x_slave[s], &self.points[s], &self.normal_law(s), &self.friction_law(s), r, k).map(|_| ())
@@ -554,8 +573,15 @@ impl PairSolver {
             let trial = self.trial(s);
             self.t_n[s] = trial.min(0.0);
             self.status[s] = if trial < 0.0 { SlaveStatus::Active } else { SlaveStatus::Open };
-            if let (Some(m), true) = (&self.mortar, trial < 0.0) {
-                self.slave_force[s] = m.slave_force(s, &self.projector) * (-self.t_n[s]);
+            if self.mortar.is_some() && trial < 0.0 {
+                self.slave_force[s] = self.normal_force(s);
+                if self.mortar_friction(s) {
+                    let st = self.node_friction_state(s).map_err(|e| (self.slaves[s], e))?;
+                    self.t_t[s] = st.t_t;
+                    self.t_t_vector[s] = st.t_t_vector;
+                    self.slipping[s] = st.slip;
+                    self.slave_force[s] += st.slave_force;
+                }
                 continue;
             }
             if trial < 0.0 {
@@ -749,8 +775,17 @@ impl PairSolver {
     pub fn tangential_force(&self) -> Vec3 {
         (0..self.slaves.len())
             .filter(|&s| self.status[s] == SlaveStatus::Active)
-            .map(|s| self.slave_force[s] - self.points[s].n_bar * (-self.t_n[s] * self.areas[s]))
+            .map(|s| self.slave_force[s] - self.normal_force(s))
             .sum()
+    }
+
+    /// The normal part of the force on the slave body through slave `s`:
+    /// −t_N A_s n̄, or −t_s ∫ N_s n̄ dA under mortar integration.
+    fn normal_force(&self, s: usize) -> Vec3 {
+        match &self.mortar {
+            Some(m) => m.slave_force(s, &self.projector) * (-self.t_n[s]),
+            None => self.points[s].n_bar * (-self.t_n[s] * self.areas[s]),
+        }
     }
 
     /// The increment converged: keep its multipliers and, with friction, the history

@@ -430,7 +430,8 @@ pub enum Integration {
     Node,
     /// Integrated over the slave faces, segment by segment against the master cells,
     /// with multipliers at the slave nodes (`contact::mortar`): passes the contact
-    /// patch test. Frictionless pairs with a face-set slave.
+    /// patch test. Needs a face-set slave; friction acts at the slave nodes, bounded
+    /// by the mortar pressure.
     Mortar,
 }
 

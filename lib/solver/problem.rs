@@ -210,9 +210,6 @@ fn contact_definitions(mesh: &Mesh, pairs: &[ContactPair], setup: &SolveSetup, f
             if slave_faces.is_empty() {
                 return Err(bad(format!("integration: mortar integrates over the slave faces, but slave '{}' is a node set; give the slave as a face set (sc-tag) or use integration: node", pair.slave)));
             }
-            if c.mu > 0.0 {
-                return Err(bad("integration: mortar is frictionless for now (mu must be 0); use integration: node for Coulomb friction".into()));
-            }
         }
         let areas = tributary_areas(mesh, &pair.slave_nodes, (pair.slave_kind == SlaveKind::FaceSet).then_some(pair.slave.as_str()));
         let penetration_tolerance = match (c.penetration_tolerance, c.penetration_tolerance_relative) {

@@ -36,8 +36,12 @@ fn setup_with(eps_n: f64, eps_t: f64, ux: f64) -> String {
 #[test]
 fn stick_slip_and_reversal_follow_the_coulomb_law() {
     let mesh = two_bodies("lower", &block([2, 2, 1], [1.0, 1.0, 0.5], 0.0), "upper", &block([2, 2, 1], [0.5, 0.5, 0.25], 0.0), [0.25, 0.25, 0.5]);
-    for (kind, orders) in [(MasterKind::Facet, None), (MasterKind::Bspline, Some([3, 3]))] {
-        let r = run_contact(&mesh, &[pair(kind, orders, "upper_z0", "lower_z1")], &setup());
+    // node-to-surface and mortar integration (friction at the nodes, bounded by the
+    // mortar pressure): the same one-dimensional law
+    for (kind, orders, integration) in [(MasterKind::Facet, None, "node"), (MasterKind::Bspline, Some([3, 3]), "node"), (MasterKind::Facet, None, "mortar"), (MasterKind::Bspline, Some([3, 3]), "mortar")] {
+        let yaml = setup().replace("enforcement: penalty", &format!("enforcement: penalty, integration: {integration}"));
+        let r = run_contact(&mesh, &[pair(kind, orders, "upper_z0", "lower_z1")], &yaml);
+        let kind = format!("{kind:?} {integration}");
         assert_eq!(r.increments.len(), 40, "{kind:?}: every increment converged without cutback");
         // One-dimensional reference: spring ε_T·A in series with a Coulomb slider of
         // capacity μN, driven by the top's u_x (the blocks are ~1000× stiffer than the

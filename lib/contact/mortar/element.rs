@@ -24,6 +24,7 @@ use nalgebra::{DMatrix, DVector};
 
 use super::{cell_nodes, Mortar};
 use crate::contact::element::{ContactElementError, ContactState, NormalLaw};
+use crate::contact::friction::{tangential_contact, FrictionLaw};
 use crate::contact::master::Projector;
 use crate::spline::{SurfacePoint, Vec3};
 
@@ -60,10 +61,21 @@ fn foot_variation(sp: &SurfacePoint, g: f64, t: &[DVector<f64>; 2], na: &[DVecto
     Ok(())
 }
 
+/// Coulomb friction of a mortar slave node: the node's own foot point and history.
+/// The tangential traction is the node-to-surface one of eqs. 4.5–4.8 at the slave
+/// node ([`tangential_contact`]) with the mortar pressure t_s as its Coulomb bound.
+pub struct NodeFriction<'a> {
+    pub foot: &'a SurfacePoint,
+    pub law: &'a FrictionLaw,
+}
+
 /// Residual and tangent of slave `s`'s mortar element (see the module docs), over
 /// the dofs of [`Mortar::element_nodes`]. `x_slave`: current slave positions;
 /// `geometry`: the master at the current configuration. Zero when the node is open.
-pub fn mortar_contact(mortar: &Mortar, s: usize, geometry: &Projector, x_slave: &[Vec3], law: &NormalLaw, r: &mut DVector<f64>, k: &mut DMatrix<f64>) -> Result<ContactState, ContactElementError> {
+/// With `friction`, the node's Coulomb traction is added, and its dependence on t_s
+/// (slip: ‖t_T‖ = μ|t_s|) chained through ∂t_s/∂u = ε_N ∂ĝ_s.
+#[allow(clippy::too_many_arguments)]
+pub fn mortar_contact(mortar: &Mortar, s: usize, geometry: &Projector, x_slave: &[Vec3], law: &NormalLaw, friction: Option<NodeFriction<'_>>, r: &mut DVector<f64>, k: &mut DMatrix<f64>) -> Result<ContactState, ContactElementError> {
     let nodes = mortar.element_nodes(s);
     let m = 3 * nodes.len();
     if r.len() != m {
@@ -204,6 +216,26 @@ pub fn mortar_contact(mortar: &Mortar, s: usize, geometry: &Projector, x_slave: 
     let t_s = trial;
     *k += &h * (t_s * a_s);
     r.axpy(t_s * a_s, &big_v, 0.0);
+    if let Some(fr) = friction {
+        let (mut rt, mut kt, mut dt) = (DVector::zeros(0), DMatrix::zeros(0, 0), DVector::zeros(0));
+        tangential_contact(&x_slave[s], fr.foot, t_s, law, fr.law, &mut rt, &mut kt, &mut dt)?;
+        let idx: Vec<usize> = std::iter::once(at(slaves[s])).chain(fr.foot.basis.nodes().iter().map(|&kk| at(net[kk]))).collect();
+        for (a, &ia) in idx.iter().enumerate() {
+            for ca in 0..3 {
+                let i = ia + ca;
+                r[i] += rt[3 * a + ca];
+                // ∂r_T/∂t_N ⊗ ε_N ∂ĝ_s
+                for j in 0..m {
+                    k[(i, j)] += dt[3 * a + ca] * law.eps_n * big_g[j];
+                }
+                for (b, &ib) in idx.iter().enumerate() {
+                    for cb in 0..3 {
+                        k[(i, ib + cb)] += kt[(3 * a + ca, 3 * b + cb)];
+                    }
+                }
+            }
+        }
+    }
     Ok(ContactState { g_n: g_hat, t_n: t_s, active: true })
 }
 
@@ -259,17 +291,31 @@ mod tests {
             x_all.extend(&x_slave);
             let mut pr = projector(order, &x_net);
             let mut mortar = Mortar::new(&faces, &slaves, &x_all, [NA, NB], &net).unwrap().unwrap();
-            let foot: Vec<_> = x_slave.iter().map(|x| pr.project(x, None).0).collect();
+            let foot: Vec<_> = x_slave.iter().map(|x| pr.project(x, None)).collect();
+            let foot_points: Vec<_> = foot.iter().map(|(p, c)| pr.evaluate(p.xi, *c)).collect();
+            let foot: Vec<_> = foot.into_iter().map(|(p, _)| p).collect();
             let areas = vec![0.6; 9];
-            mortar.integrate(&pr, &x_net, &x_slave, &foot, &areas).unwrap();
+            mortar.integrate(&pr, &x_net, &x_slave, &foot, &foot_points, &areas).unwrap();
             let s = 4;
             let nodes = mortar.element_nodes(s).to_vec();
             assert!(nodes.len() > 9 + 4, "order {order}: element nodes {nodes:?}");
             let m = 3 * nodes.len();
-            for (lambda, eps) in [(0.0, 1e3), (-2.0, 50.0), (-1.0, 0.0)] {
+            // (λ_N, ε_N, friction: None or (ε_T, expected slip)); the node's history
+            // ξ̄_n 0.02/na behind its foot point, t_Tα,n small: ε_T = 1e3 slips
+            // (ε_T ā Δξ ≈ 20 ≫ μ|t_s|), ε_T = 5 sticks
+            let (foot_s, cell_s) = pr.project(&x_slave[s], None);
+            let xi_n = [foot_s.xi[0] - 0.02 / NA as f64, foot_s.xi[1] + 0.01 / NB as f64];
+            for (lambda, eps, fric) in [(0.0, 1e3, None), (-2.0, 50.0, None), (-1.0, 0.0, None), (-1.0, 50.0, Some((1e3, true))), (-1.0, 50.0, Some((5.0, false)))] {
                 let law = NormalLaw { lambda_n: lambda, eps_n: eps, area: areas[s], touch: 0.0 };
+                let flaw = fric.map(|(eps_t, _)| FrictionLaw { mu: 0.3, eps_t, xi_n, t_t_n: [0.05, -0.02], held_slip: None });
+                let node_friction = |foot: &SurfacePoint| flaw.as_ref().map(|l| (*foot, *l));
                 let (mut r, mut k) = (DVector::zeros(0), DMatrix::zeros(0, 0));
-                let st = mortar_contact(&mortar, s, &pr, &x_slave, &law, &mut r, &mut k).unwrap();
+                let nf = node_friction(&foot_points[s]);
+                let st = mortar_contact(&mortar, s, &pr, &x_slave, &law, nf.as_ref().map(|(f, l)| NodeFriction { foot: f, law: l }), &mut r, &mut k).unwrap();
+                if let (Some((_, want_slip)), Some(l)) = (fric, &flaw) {
+                    let fs = crate::contact::friction::tangential_state(&x_slave[s], &foot_points[s], st.t_n, &law, l).unwrap();
+                    assert_eq!(fs.slip, want_slip, "order {order}: {fs:?}");
+                }
                 assert!(st.active && st.g_n < 0.0, "order {order}: {st:?}");
                 let u: Vec<f64> = nodes.iter().flat_map(|&n| x_all[n as usize].iter().copied().collect::<Vec<_>>()).collect();
                 let mut mfd = mortar_clone(&mortar);
@@ -282,19 +328,26 @@ mod tests {
                         let (xn, xs) = (&x[..NA * NB], &x[NA * NB..]);
                         pr.update(xn).unwrap();
                         mfd.refresh(&pr, xn, xs, &areas).unwrap();
+                        let (fp, fc) = pr.project(&xs[s], cell_s);
+                        let foot = pr.evaluate(fp.xi, fc);
+                        assert_eq!(foot.basis.nodes(), foot_points[s].basis.nodes(), "perturbation moved the node's foot to another span");
+                        let nf = node_friction(&foot);
                         let (mut rr, mut kk) = (DVector::zeros(m), DMatrix::zeros(m, m));
-                        mortar_contact(&mfd, s, &pr, xs, &law, &mut rr, &mut kk).unwrap();
+                        mortar_contact(&mfd, s, &pr, xs, &law, nf.as_ref().map(|(f, l)| NodeFriction { foot: f, law: l }), &mut rr, &mut kk).unwrap();
                         out.copy_from_slice(rr.as_slice());
                     },
                     &u,
                     m,
-                    FdStep { rel_step: 1e-7, scale: 1.0 },
+                    // h = 1e-6: the B-spline foot points converge to ~1e-12 of the
+                    // scale, whose round-off in n̄ would reach ~1e-6 of K at h = 1e-7;
+                    // truncation ~h² stays ≪ 1e-6
+                    FdStep { rel_step: 1e-6, scale: 1.0 },
                 );
                 pr.update(&x_net).unwrap();
                 let e = rel_err(k.as_slice(), k_fd.as_slice());
-                eprintln!("mortar order {order} (λ {lambda}, ε {eps}): |K − K_fd| / |K| = {e:.2e}, {} nodes", nodes.len());
-                assert!(e < 1e-6, "order {order} (λ {lambda}, ε {eps}): relative error {e:e}");
-                if order <= 2 {
+                eprintln!("mortar order {order} (λ {lambda}, ε {eps}, friction {fric:?}): |K − K_fd| / |K| = {e:.2e}, {} nodes", nodes.len());
+                assert!(e < 1e-6, "order {order} (λ {lambda}, ε {eps}, friction {fric:?}): relative error {e:e}");
+                if order <= 2 && fric.is_none() {
                     let asym = (&k - k.transpose()).abs().max() / k.abs().max();
                     assert!(asym < 1e-10, "facet master: K symmetric, found {asym:e}");
                 }

@@ -39,7 +39,7 @@ use rayon::prelude::*;
 
 use self::segment::{clip_convex, face_jacobian, face_point, inverse_bilinear, is_convex_ccw, polygon_quadrature, quad4, signed_area2, P2, SQUARE};
 use super::master::Projector;
-use crate::spline::{FacetProjector, FacetSurface, Projection, SplineError, Vec3};
+use crate::spline::{FacetProjector, FacetSurface, Projection, SplineError, SurfacePoint, Vec3};
 
 /// One quadrature point of the slave surface, with its foot points on the master.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -197,7 +197,10 @@ impl Mortar {
     /// quadrature points onto the master, and sums the weighted gaps ĝ_s. `x_net`:
     /// the current net (already in `geometry`); `x_slave`, `foot`: the slaves'
     /// current positions and their own projections (warm starts); `areas`: A_s.
-    pub fn integrate(&mut self, geometry: &Projector, x_net: &[Vec3], x_slave: &[Vec3], foot: &[Projection], areas: &[f64]) -> Result<(), SplineError> {
+    ///
+    /// `foot_points`: the slaves' own surface points, whose basis nodes join the
+    /// element (friction acts at the slave node, `element::NodeFriction`).
+    pub fn integrate(&mut self, geometry: &Projector, x_net: &[Vec3], x_slave: &[Vec3], foot: &[Projection], foot_points: &[SurfacePoint], areas: &[f64]) -> Result<(), SplineError> {
         self.trace.update(x_net)?;
         let trace = &self.trace;
         self.node_cell.par_iter_mut().zip(x_slave.par_iter()).with_min_len(64).for_each(|(c, x)| {
@@ -292,6 +295,12 @@ impl Mortar {
                     }
                     if !points[f as usize].is_empty() {
                         nodes.extend(face.iter().map(|&c| slaves[c as usize]));
+                    }
+                }
+                if cw > 0.0 {
+                    nodes.push(slaves[s]);
+                    if foot[s].converged {
+                        nodes.extend(foot_points[s].basis.nodes().iter().map(|&k| net[k]));
                     }
                 }
                 nodes.sort_unstable();
