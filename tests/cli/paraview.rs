@@ -94,6 +94,25 @@ fn vtk_reads_the_frictional_crossed_beams_series() {
     assert_eq!(f64s(&model["pairs"][0]["net"]), [3.0, 16.0], "{model:?}");
 }
 
+/// The facet master (curved pad, `pipelines/curved-facet.yaml`): its tessellated
+/// surface goes through every node of the net, in the model and in each step of the
+/// deformed series.
+#[test]
+fn vtk_reads_the_facet_master_files() {
+    let dir = staged_pipeline("curved-facet", &["curved-nby3.msh"]);
+    let o = run("sc-pipeline", &["-q", "pipelines/curved-facet.yaml"], dir.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = dir.path().join("pipelines/out");
+    let o = run("sc-export", &["-q", "curved-facet.sccontact", "-o", "curved-facet.vtu"], &out);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let model = check_vtk("contact", &out.join("curved-facet.vtu"), &out.join("curved-facet.sccontact"));
+    // a 7 × 4 net: 6 × 3 facets of 8 × 8 quads
+    assert_eq!(model["pairs"][0]["surface_quads"].as_u64(), Some(6 * 3 * 64), "{model:?}");
+    let res = check_vtk("results", &out.join("curved-facet.pvd"), &out.join("curved-facet.scres"));
+    assert_eq!(res["steps"].as_u64(), Some(6), "{res:?}");
+    assert_eq!(res["surfaces"][0]["steps"].as_u64(), Some(6), "{res:?}");
+}
+
 fn on_path(exe: &str) -> bool {
     std::env::var_os("PATH").is_some_and(|p| std::env::split_paths(&p).any(|d| d.join(exe).is_file()))
 }
