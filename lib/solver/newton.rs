@@ -32,6 +32,11 @@ use crate::solver::linear::{FaerDirect, FaerDirectOptions, LinearSolver, LinearS
 use crate::solver::ordering::FillOrdering;
 use crate::solver::symmetric_part::SymmetricPartGmres;
 
+
+/// Relative residual below which mortar pairs hold their segmentation for the rest
+/// of the solve (`PairSolver::hold_segmentation`): the quadrature then no longer
+/// moves, and what is left of the correction is below the segments' size by far.
+const MORTAR_HOLD_RESIDUAL: f64 = 1e-5;
 /// The loosest an inexact Newton's linear solve stops at (the first of each solve;
 /// [`Forcing`]). Looser first solves (1e-2) measured more Newton iterations on the
 /// frictional crossed beams.
@@ -610,6 +615,12 @@ impl<'p> Newton<'p> {
                 du <= 1e3 * f64::EPSILON * un
             };
             let converged = (residual <= self.settings.residual_tolerance || at_round_off) && (iteration == 0 || energy <= self.settings.energy_tolerance);
+            // Mortar pairs: near the solution, hold the segmentation (PairSolver::hold_segmentation)
+            if !converged && iteration > 0 && residual < MORTAR_HOLD_RESIDUAL {
+                for pair in &mut self.contact {
+                    pair.hold_segmentation();
+                }
+            }
             let mut row = IterationLog {
                 iteration,
                 residual,

@@ -80,11 +80,11 @@ pub struct ContactDefinition {
 impl ContactDefinition {
     /// Whether the pair's contact tangent is symmetric: frictionless, and the master
     /// virtual displacement the variation of its geometry (node-to-surface; mortar
-    /// with facets or a bilinear patch, whose trace is the surface itself). Slip, and
-    /// a mortar pair's B-spline master of order ≥ 3 (geometry from the patch, forces
-    /// through the facet trace, `contact::mortar`) make it non-symmetric.
+    /// with facets, whose trace is the surface itself). Slip, and a mortar pair's
+    /// B-spline master (geometry from the patch, forces through the facet trace of
+    /// the segment's cell, `contact::mortar`) make it non-symmetric.
     pub fn symmetric_tangent(&self) -> bool {
-        let trace_is_geometry = self.pair.master_kind == MasterKind::Facet || self.pair.orders == [2, 2];
+        let trace_is_geometry = self.pair.master_kind == MasterKind::Facet;
         !self.settings.frictional() && (self.settings.integration == Integration::Node || trace_is_geometry)
     }
 }

@@ -37,7 +37,7 @@ pub mod segment;
 
 use rayon::prelude::*;
 
-use self::segment::{clip_convex, face_jacobian, face_point, inverse_bilinear, is_convex_ccw, polygon_quadrature, quad4, signed_area2, P2, SQUARE};
+use self::segment::{clip_convex, face_jacobian, face_point, is_convex_ccw, polygon_quadrature, quad4, ray_bilinear, signed_area2, P2, SQUARE};
 use super::master::Projector;
 use crate::spline::{FacetProjector, FacetSurface, Projection, SplineError, SurfacePoint, Vec3};
 
@@ -232,9 +232,12 @@ impl Mortar {
                     for i in lo[0]..=hi[0] {
                         let k00 = i + na * j;
                         let corners = [k00, k00 + 1, k00 + 1 + na, k00 + na];
+                        let (lo, hi) = trace.facets().cell_bounds([i, j]);
+                        let corner_xi = [[lo[0], lo[1]], [hi[0], lo[1]], [hi[0], hi[1]], [lo[0], hi[1]]];
                         let mut quad = Vec::with_capacity(4);
-                        for &k in &corners {
-                            match inverse_bilinear(&xf, &x_net[k]) {
+                        for (&k, &cxi) in corners.iter().zip(&corner_xi) {
+                            let n = trace.evaluate_in_cell(cxi, [i, j]).n_bar;
+                            match ray_bilinear(&xf, &x_net[k], &n) {
                                 Some(e) => quad.push(P2::new(e[0], e[1])),
                                 None => break,
                             }

@@ -7,8 +7,11 @@
 //! rule over the whole face is therefore not exact, and the patch test fails by the
 //! quadrature error. So each slave face is cut into segments, one per master cell:
 //! ```text
-//! 1. the cell's four corners, projected onto the slave face, give a quadrilateral
-//!    in the face's parameter square [−1, 1]² (inverse bilinear map, least squares);
+//! 1. the cell's four corners, carried along the cell's normal onto the slave face,
+//!    give a quadrilateral in the face's parameter square [−1, 1]² (where the
+//!    normal line through a corner meets the face: those lines bound the points
+//!    whose foot lies in the cell, so the segment edges follow the integrand's kinks
+//!    also where the faces are inclined to each other);
 //! 2. the square clipped by that quadrilateral (Sutherland–Hodgman, both convex) is
 //!    the segment, a convex polygon;
 //! 3. a fan of triangles covers it; each gets the 7-point rule of degree 5.
@@ -79,23 +82,23 @@ pub fn face_jacobian(x: &[Vec3; 4], eta: [f64; 2]) -> f64 {
     t[0].cross(&t[1]).norm()
 }
 
-/// The face parameter η whose point is closest to `p` (Gauss–Newton on the bilinear
-/// map, from the centre; continued beyond the square, since master corners lie
-/// outside it). `None` when it does not converge (a degenerate face).
-pub fn inverse_bilinear(x: &[Vec3; 4], p: &Vec3) -> Option<[f64; 2]> {
-    let mut eta = [0.0, 0.0];
+/// The face parameter η where the line `p + t d` meets the face (Newton on
+/// x(η) − p − t d = 0 in (η¹, η², t), from the centre). `None` when it does not
+/// converge (the line parallel to the face).
+pub fn ray_bilinear(x: &[Vec3; 4], p: &Vec3, d: &Vec3) -> Option<[f64; 2]> {
+    let (mut eta, mut t) = ([0.0, 0.0], 0.0);
     for _ in 0..30 {
-        let (q, t) = face_point(x, eta);
-        let d = p - q;
-        let m = nalgebra::Matrix2::new(t[0].dot(&t[0]), t[0].dot(&t[1]), t[1].dot(&t[0]), t[1].dot(&t[1]));
-        let rhs = Vector2::new(t[0].dot(&d), t[1].dot(&d));
-        let step = m.try_inverse()? * rhs;
-        eta[0] += step[0];
-        eta[1] += step[1];
+        let (q, tg) = face_point(x, eta);
+        let f = q - p - d * t;
+        let jac = nalgebra::Matrix3::from_columns(&[tg[0], tg[1], -d]);
+        let step = jac.try_inverse()? * f;
+        eta[0] -= step[0];
+        eta[1] -= step[1];
+        t -= step[2];
         if !(eta[0].is_finite() && eta[1].is_finite()) || eta[0].abs() > 1e6 || eta[1].abs() > 1e6 {
             return None;
         }
-        if step.norm() < 1e-14 * (1.0 + eta[0].abs() + eta[1].abs()) {
+        if step.norm() < 1e-14 * (1.0 + eta[0].abs() + eta[1].abs() + t.abs()) {
             return Some(eta);
         }
     }
@@ -205,18 +208,18 @@ mod tests {
     }
 
     #[test]
-    fn inverse_bilinear_recovers_the_parameter() {
-        // a flat face: a point off it by 0.01 along the normal maps back exactly
-        let flat = [Vec3::new(0.0, 0.0, 0.0), Vec3::new(2.0, 0.1, 0.0), Vec3::new(2.2, 1.5, 0.0), Vec3::new(-0.1, 1.2, 0.0)];
-        // a warped one: points on it map back exactly
-        let warped = [flat[0], flat[1], Vec3::new(2.2, 1.5, 0.2), Vec3::new(-0.1, 1.2, 0.1)];
+    fn a_line_meets_the_face_at_its_parameter() {
+        // a warped face, lines through its points in an oblique direction (also
+        // beyond the square, where master corners lie)
+        let x = [Vec3::new(0.0, 0.0, 0.0), Vec3::new(2.0, 0.1, 0.0), Vec3::new(2.2, 1.5, 0.2), Vec3::new(-0.1, 1.2, 0.1)];
+        let d = Vec3::new(0.2, -0.1, 1.0);
         for eta in [[0.3, -0.2], [-0.9, 0.8], [1.4, -1.3]] {
-            let (p, _) = face_point(&flat, eta);
-            let back = inverse_bilinear(&flat, &(p + Vec3::z() * 0.01)).unwrap();
+            let (p, _) = face_point(&x, eta);
+            let back = ray_bilinear(&x, &(p + d * 0.37), &d).unwrap();
             assert!((back[0] - eta[0]).abs() < 1e-12 && (back[1] - eta[1]).abs() < 1e-12, "{back:?} vs {eta:?}");
-            let (p, _) = face_point(&warped, eta);
-            let exact = inverse_bilinear(&warped, &p).unwrap();
-            assert!((exact[0] - eta[0]).abs() < 1e-12 && (exact[1] - eta[1]).abs() < 1e-12, "{exact:?} vs {eta:?}");
         }
+        // a line in the face's plane does not meet it in one point
+        let flat = [Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(1.0, 1.0, 0.0), Vec3::new(0.0, 1.0, 0.0)];
+        assert!(ray_bilinear(&flat, &Vec3::new(0.5, 0.5, 1.0), &Vec3::x()).is_none());
     }
 }
