@@ -47,6 +47,8 @@ pub struct PairSettings {
     pub stabilization: f64,
     /// Node-to-surface or mortar (`contact::mortar`).
     pub integration: Integration,
+    /// Mortar: the multiplier basis.
+    pub multipliers: crate::format::setup::MortarMultipliers,
 }
 
 impl PairSettings {
@@ -279,7 +281,7 @@ impl PairSolver {
         let mortar = match settings.integration {
             Integration::Node => None,
             Integration::Mortar => Some(
-                Mortar::new(&def.slave_faces, &pair.slave_nodes, x_ref, [a, b], &pair.net.nodes)
+                Mortar::new(&def.slave_faces, &pair.slave_nodes, x_ref, [a, b], &pair.net.nodes, settings.multipliers)
                     .map_err(err)?
                     .map_err(|source| PairError::Mortar { pair: pair.name.clone(), source })?,
             ),
@@ -385,7 +387,7 @@ impl PairSolver {
                 });
         }
         if let Some(mortar) = self.mortar.as_mut().filter(|_| self.segmentation_held) {
-            mortar.refresh(&self.projector, &self.x_net, &self.x_slave, &self.areas).map_err(|source| PairError::Master { pair: self.name.clone(), source })?;
+            mortar.refresh(&self.projector, &self.x_net, &self.x_slave, &self.projections, &self.points, &self.areas).map_err(|source| PairError::Master { pair: self.name.clone(), source })?;
         } else if let Some(mortar) = &mut self.mortar {
             mortar.integrate(&self.projector, &self.x_net, &self.x_slave, &self.projections, &self.points, &self.areas).map_err(|source| PairError::Master { pair: self.name.clone(), source })?;
         }
@@ -890,7 +892,7 @@ mod tests {
             slave_nodes: (30..70).collect(),
             net: ControlNet { a, b, nodes: (0..30).collect() },
         };
-        let settings = PairSettings { eps_n: 1e3, enforcement: Enforcement::Penalty, penetration_tolerance: 1e-3, max_augmentations: 0, update_halvings: 0, mu: 0.0, eps_t: 0.0, stabilization: 0.0, integration: Integration::Node };
+        let settings = PairSettings { eps_n: 1e3, enforcement: Enforcement::Penalty, penetration_tolerance: 1e-3, max_augmentations: 0, update_halvings: 0, mu: 0.0, eps_t: 0.0, stabilization: 0.0, integration: Integration::Node, multipliers: Default::default() };
         let def = ContactDefinition { pair, settings, areas: vec![0.01; 40], slave_faces: Vec::new(), h_master: 0.2, eps_n_default: false, adjust: None, allow_flipped_master: false };
         let solver = PairSolver::new(&def, &x).unwrap();
         (x, solver)

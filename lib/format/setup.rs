@@ -435,6 +435,18 @@ pub enum Integration {
     Mortar,
 }
 
+/// The multiplier basis of a mortar pair (`contact::mortar`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum MortarMultipliers {
+    /// Φ_s = N_s, the slave faces' bilinear functions.
+    #[default]
+    Standard,
+    /// Biorthogonal to N_s per face (Wohlmuth 2000): each slave node couples only to
+    /// its own multiplier.
+    Dual,
+}
+
 /// Contact settings of one pair of the `.sccontact` model (by its name).
 #[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
@@ -451,6 +463,9 @@ pub struct ContactSetup {
     /// Where the constraint is imposed: `node` (default) or `mortar`.
     #[serde(default, skip_serializing_if = "is_node")]
     pub integration: Integration,
+    /// Mortar integration: the multiplier basis, `standard` (default) or `dual`.
+    #[serde(default, skip_serializing_if = "is_standard")]
+    pub multipliers: MortarMultipliers,
     /// Largest accepted penetration −g_N (a length), augmented Lagrangian only.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub penetration_tolerance: Option<f64>,
@@ -486,6 +501,10 @@ pub struct ContactSetup {
     /// (`check::orientation`); without it such a pair is refused.
     #[serde(default, skip_serializing_if = "is_false")]
     pub allow_flipped_master: bool,
+}
+
+fn is_standard(v: &MortarMultipliers) -> bool {
+    *v == MortarMultipliers::Standard
 }
 
 fn is_node(v: &Integration) -> bool {

@@ -1,3 +1,4 @@
 //! Post-processing of converged states: stress measures and nodal fields.
-pub mod stresses;
+pub mod contact_pressure;
 pub mod oscillation;
+pub mod stresses;

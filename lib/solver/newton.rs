@@ -35,7 +35,13 @@ use crate::solver::symmetric_part::SymmetricPartGmres;
 
 /// Relative residual below which mortar pairs hold their segmentation for the rest
 /// of the solve (`PairSolver::hold_segmentation`): the quadrature then no longer
-/// moves, and what is left of the correction is below the segments' size by far.
+/// moves, and what is left of the correction is far below the segments' size.
+/// Measured on the shallow ironing (B-spline [2, 4], frictionless, to t = 1.1):
+/// 1188 Newton corrections holding at 1e-5, 845 at 1e-3, 817 at 1e-2 (node-to-surface:
+/// 724); but a segmentation held from 1e-2 on leaves the patch test's pressure off
+/// by 5e-6 (the segments of a configuration that still moves), 1e-5 by ≤ 2.4e-9.
+/// Re-segmenting a state that converged held, and going on when its residual is
+/// above the tolerance, cycles at 3e-8–8e-8 on the ironing's first contact.
 const MORTAR_HOLD_RESIDUAL: f64 = 1e-5;
 /// The loosest an inexact Newton's linear solve stops at (the first of each solve;
 /// [`Forcing`]). Looser first solves (1e-2) measured more Newton iterations on the

@@ -151,8 +151,62 @@ pub fn write_results_pvd(results: &Results, output: &Path) -> Result<String, Sta
         vtk::write_pvd(&pvd, &series)?;
         surfaces.push(pvd.display().to_string());
     }
+    // the slave surfaces with the pressure per node and per face: one series per pair
+    let mut slaves = Vec::new();
+    for (p, pair) in results.pairs.iter().enumerate() {
+        let Some(faces) = slave_faces(mesh, pair) else { continue };
+        let mut series = Vec::new();
+        for (k, inc) in std::iter::once(&zero).chain(results.increments.iter()).enumerate() {
+            let name = format!("{stem}_{}_slave_{k}.vtu", pair.name);
+            let pressure = |s: usize| inc.contact.get(p).and_then(|st| st.get(s)).map_or(0.0, |row| -row[1]);
+            slave_surface_grid(mesh, pair, &faces, &inc.u, pressure).write_vtu(&dir.join(&name))?;
+            series.push((inc.info.load_factor, name));
+        }
+        let pvd = dir.join(format!("{stem}_{}_slave.pvd", pair.name));
+        vtk::write_pvd(&pvd, &series)?;
+        slaves.push(pvd.display().to_string());
+    }
     let also = if surfaces.is_empty() { String::new() } else { format!("; master surfaces (deformed, per increment): {}", surfaces.join(", ")) };
+    let also = if slaves.is_empty() { also } else { format!("{also}; slave surfaces with the pressure per node and per face: {}", slaves.join(", ")) };
     Ok(format!("wrote {} ({} increments + the undeformed state){also}", output.display(), results.increments.len()))
+}
+
+/// The faces of a pair's slave face set (mesh node ids), `None` for a node-set slave.
+fn slave_faces(mesh: &crate::mesh::Mesh, pair: &ContactPair) -> Option<Vec<[u32; 4]>> {
+    if pair.slave_kind != crate::format::sccontact::SlaveKind::FaceSet {
+        return None;
+    }
+    mesh.face_set(&pair.slave).map(|fs| fs.faces.iter().map(|&f| mesh.face_nodes(f)).collect())
+}
+
+/// A pair's slave surface, deformed by `u`: its faces as quads over the slave nodes,
+/// point data `contact_pressure` (−t_N of each slave node, `pressure(s)` by slave
+/// index) and `gmsh_node_tag`, cell data `contact_pressure_face` (the mean of the
+/// interpolated pressure over the face, `post::contact_pressure`).
+pub fn slave_surface_grid(mesh: &crate::mesh::Mesh, pair: &ContactPair, faces: &[[u32; 4]], u: &[[f64; 3]], pressure: impl Fn(usize) -> f64) -> vtk::Grid {
+    let nodes = &pair.slave_nodes;
+    let points = nodes
+        .iter()
+        .map(|&n| {
+            let (x, d) = (mesh.nodes[n as usize], u[n as usize]);
+            [x[0] + d[0], x[1] + d[1], x[2] + d[2]]
+        })
+        .collect();
+    let mut g = vtk::Grid { points, ..Default::default() };
+    let local = |n: u32| nodes.binary_search(&n).ok();
+    let mut kept = Vec::with_capacity(faces.len());
+    for f in faces {
+        if let [Some(a), Some(b), Some(c), Some(d)] = f.map(local) {
+            g.push_cell(vtk::CellKind::Quad, &[a as u32, b as u32, c as u32, d as u32]);
+            kept.push(*f);
+        }
+    }
+    let nodal: Vec<f64> = (0..nodes.len()).map(&pressure).collect();
+    let face = crate::post::contact_pressure::face_pressures(mesh, &kept, |n| local(n).map_or(0.0, |s| nodal[s]));
+    g.point_data.push(vtk::Field::scalar_f64("contact_pressure", nodal));
+    g.point_data.push(vtk::Field { name: "gmsh_node_tag".into(), components: 1, values: vtk::FieldValues::I64(nodes.iter().map(|&n| mesh.node_tags[n as usize] as i64).collect()) });
+    g.cell_data.push(vtk::Field::scalar_f64("contact_pressure_face", face));
+    g
 }
 
 /// Contact point data on the slave nodes of every pair (state columns of

@@ -271,3 +271,27 @@ fn restart_keeps_the_augmented_lagrangian_multipliers() {
     assert_eq!(aug(&continued), aug(&full));
     assert!(aug(&forgetful)[0] > aug(&full)[0], "the comparison does not see the multipliers");
 }
+
+/// The restart under mortar integration (issue 25: restart, friction history and
+/// multipliers as under `node`): the augmented-Lagrangian path above with
+/// `integration: mortar`, cut at t = 2.4. The mortar multipliers are nodal and the
+/// friction history stays the node's, so the results file carries them in the same
+/// columns: the continued run reaches the uninterrupted one's states (tolerance 1e-8
+/// of max |u|, the inexact GMRES solves as above), with the same augmentations, and a
+/// run with λ_N zeroed in the file needs more.
+#[test]
+fn restart_under_mortar_keeps_the_multipliers() {
+    const CUT: usize = 24;
+    let yaml = setup_with(1.0e8, 1.0e8, 2.0e-3).replace("enforcement: penalty", "enforcement: augmented_lagrangian, penetration_tolerance: 1.0e-7, max_augmentations: 30, integration: mortar");
+    let [full, continued, forgetful] = cut_and_continue(&yaml, CUT, |inc| {
+        for row in inc.contact[0].iter_mut() {
+            row[2] = 0.0;
+        }
+    });
+    let aug = |r: &splinecontact::format::scres::Results| r.increments[CUT..].iter().map(|i| i.info.contact[0].augmentations).collect::<Vec<_>>();
+    let du = u_difference(&continued, &full, CUT);
+    eprintln!("mortar, augmented Lagrangian: continued run off by {du:.3e} max |u|; augmentations {:?}, continued {:?}, without λ_N {:?}", aug(&full), aug(&continued), aug(&forgetful));
+    assert!(du <= 1e-8, "continued run differs by {du:e} of max |u|");
+    assert_eq!(aug(&continued), aug(&full));
+    assert!(aug(&forgetful)[0] > aug(&full)[0], "the comparison does not see the multipliers");
+}

@@ -270,3 +270,39 @@ const STAB_LIMIT: f64 = 0.07;
 /// |H| / V at t = 1.5 with a frictionless facet master: measured 0.023, from the
 /// snaps over the creases (the B-spline master: 1.1e-4); twice that.
 const H_LIMIT: f64 = 0.05;
+
+/// `pipeline` with the solve stage's contact pair under `integration: mortar`.
+fn mortar(pipeline: &str) -> String {
+    let mut doc: Value = serde_yaml::from_str(pipeline).unwrap();
+    let stages = doc.get_mut("stages").and_then(Value::as_sequence_mut).unwrap();
+    let setup = stages.iter_mut().find_map(|s| s.get_mut("solve")).and_then(|s| s.get_mut("setup")).unwrap();
+    let contact = setup.get_mut("contact").and_then(Value::as_sequence_mut).unwrap();
+    contact[0].as_mapping_mut().unwrap().insert("integration".into(), "mortar".into());
+    serde_yaml::to_string(&doc).unwrap()
+}
+
+/// Issue 25's "large sliding is not worse", measured: the B-spline [2, 4] chains under
+/// mortar integration (standard multipliers; the same pipelines, to t = 1.5), against
+/// their node-to-surface pins. V(1.5) within 1 % of node-to-surface's (the same master
+/// and load path; the integration moves the penetration's distribution, not the
+/// load); the V oscillation and the Newton corrections pinned at their measured values
+/// (tolerances of [`check`]). Not met, and so recorded in
+/// docs/validation/shallow-ironing.md: the issue's "oscillation no worse" (measured
+/// 2.2× node-to-surface's frictionless, 9.1× with μ = 0.3) and "corrections within
+/// 30 %" (3.1× and 2.5×).
+#[test]
+fn shallow_ironing_mortar_bspline() {
+    for (name, pin, node) in [("shallow_ironing_frictionless", &PIN_MORTAR_FRICTIONLESS, &PIN_FRICTIONLESS), ("shallow_ironing", &PIN_MORTAR_COULOMB, &PIN_COULOMB)] {
+        let run = solve_pipeline(name, "b4", &mortar(&derived_pipeline(name, "b4", true)));
+        assert!((run.0.s.last().unwrap() - 5.0).abs() < 1e-9, "{name}: the run ends at t = 1.5");
+        let (v, _) = check(&format!("{name} mortar"), &run, pin);
+        assert!((v / node.v_15 - 1.0).abs() < 0.01, "{name} mortar: V(1.5) = {v} against node-to-surface {}", node.v_15);
+        let (its, _) = newton_and_cutbacks(&run.1);
+        let osc = oscillation(&run.0.s, &run.0.v, ELEMENT, STEADY.0, STEADY.1).unwrap().rms;
+        eprintln!("{name} mortar against node-to-surface: V oscillation × {:.2}, Newton corrections × {:.2}", osc / node.v_rms, its as f64 / node.newton as f64);
+    }
+}
+
+/// Measured (2026-11-25), standard multipliers, segmentation held below 1e-5.
+const PIN_MORTAR_FRICTIONLESS: Pin = Pin { v_15: 394.95, v_rms: 3.25e-4, newton: 3529, cutbacks: 0 };
+const PIN_MORTAR_COULOMB: Pin = Pin { v_15: 397.70, v_rms: 9.87e-4, newton: 2899, cutbacks: 0 };

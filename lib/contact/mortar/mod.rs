@@ -1,11 +1,12 @@
 //! Segment-to-segment (mortar) integration of the normal contact constraint over the
 //! slave surface: `integration: mortar` of a pair. The one-pass node-to-surface
 //! method of the paper (`integration: node`) puts the whole constraint at the slave
-//! nodes; here it is integrated over the slave faces, with standard (bilinear)
-//! slave-side multipliers at the slave nodes (Puso & Laursen 2004; for smooth
-//! masters De Lorenzis, Wriggers & Zavarise 2011). Per slave node s:
+//! nodes; here it is integrated over the slave faces, with slave-side multipliers at
+//! the slave nodes (Puso & Laursen 2004; for smooth masters De Lorenzis, Wriggers &
+//! Zavarise 2011): standard, Φ_s = N_s, or dual (biorthogonal, Wohlmuth 2000),
+//! Φ_s per face from [`dual_basis`] ([`Multipliers`]). Per slave node s:
 //! ```text
-//! ĝ_s  = (1/A_s) ∫_Γs N_s g dA₀            weighted gap, g = (x − x̄(ξ̄(x)))·n̄ at every
+//! ĝ_s  = (1/A_s) ∫_Γs Φ_s g dA₀            weighted gap, g = (x − x̄(ξ̄(x)))·n̄ at every
 //!                                          point x of the slave surface, projected
 //!                                          onto the master (eq. 2.2)
 //! t_s  = min(0, λ_s + ε_N ĝ_s)             the law of eq. 4.2 on the weighted gap
@@ -41,6 +42,10 @@ use self::segment::{clip_convex, face_jacobian, face_point, is_convex_ccw, polyg
 use super::master::Projector;
 use crate::spline::{FacetProjector, FacetSurface, Projection, SplineError, SurfacePoint, Vec3};
 
+pub use crate::format::setup::MortarMultipliers as Multipliers;
+
+const IDENTITY: [[f64; 4]; 4] = [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]];
+
 /// One quadrature point of the slave surface, with its foot points on the master.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MortarPoint {
@@ -66,6 +71,9 @@ pub struct Mortar {
     faces: Vec<[u32; 4]>,
     /// Their reference corner coordinates (dA₀).
     faces_ref: Vec<[Vec3; 4]>,
+    /// Per face, the multiplier basis Φ_i = Σ_j a_ij N_j (identity: standard;
+    /// [`dual_basis`]: dual).
+    duals: Vec<[[f64; 4]; 4]>,
     /// The faces around each slave.
     faces_of: Vec<Vec<u32>>,
     /// The trace: the master net read as facets (segmentation and δ̃g).
@@ -103,7 +111,7 @@ impl Mortar {
     /// `faces`: the slave faces as mesh node ids (cycle order); `slaves`: the pair's
     /// slave nodes (sorted); `x_ref`: reference coordinates of all mesh nodes;
     /// `net_dims`, `net`: the master control net's size and mesh nodes.
-    pub fn new(faces: &[[u32; 4]], slaves: &[u32], x_ref: &[Vec3], net_dims: [usize; 2], net: &[u32]) -> Result<Result<Self, MortarError>, SplineError> {
+    pub fn new(faces: &[[u32; 4]], slaves: &[u32], x_ref: &[Vec3], net_dims: [usize; 2], net: &[u32], multipliers: Multipliers) -> Result<Result<Self, MortarError>, SplineError> {
         let x_net: Vec<Vec3> = net.iter().map(|&n| x_ref[n as usize]).collect();
         let x_net = &x_net[..];
         let trace = FacetProjector::new(FacetSurface::new(net_dims[0], net_dims[1])?, x_net)?;
@@ -124,11 +132,16 @@ impl Mortar {
         if let Some(s) = faces_of.iter().position(|f| f.is_empty()) {
             return Ok(Err(MortarError::NodeWithoutFace { node: slaves[s] }));
         }
-        let faces_ref = faces.iter().map(|f| f.map(|n| x_ref[n as usize])).collect();
+        let faces_ref: Vec<[Vec3; 4]> = faces.iter().map(|f| f.map(|n| x_ref[n as usize])).collect();
+        let duals = match multipliers {
+            Multipliers::Standard => vec![IDENTITY; faces_ref.len()],
+            Multipliers::Dual => faces_ref.iter().map(dual_basis).collect(),
+        };
         let n = slaves.len();
         Ok(Ok(Self {
             faces: local,
             faces_ref,
+            duals,
             faces_of,
             trace,
             na: net_dims[0],
@@ -142,6 +155,12 @@ impl Mortar {
             net: net.to_vec(),
             slaves: slaves.to_vec(),
         }))
+    }
+
+    /// Φ_l at a point of face `f` with slave shape functions `n` (the dual basis
+    /// function of the face's corner `l`).
+    pub fn dual_shape(&self, f: u32, l: usize, n: &[f64; 4]) -> f64 {
+        dual_shape(&self.duals[f as usize], l, n)
     }
 
     /// The faces around slave `s`.
@@ -187,7 +206,7 @@ impl Mortar {
         for &fc in &self.faces_of[s] {
             let Some(l) = self.faces[fc as usize].iter().position(|&c| c as usize == s) else { continue };
             for p in &self.points[fc as usize] {
-                f += geometry.evaluate(p.xi, Some(p.cell)).n_bar * (p.w * p.n[l]);
+                f += geometry.evaluate(p.xi, Some(p.cell)).n_bar * (p.w * self.dual_shape(fc, l, &p.n));
             }
         }
         f
@@ -275,8 +294,40 @@ impl Mortar {
             })
             .sum();
         self.skipped_cells = skipped;
-        // ĝ_s, the covered area and the element's nodes
-        let (faces, faces_of, points, net, slaves) = (&self.faces, &self.faces_of, &self.points, &self.net, &self.slaves);
+        self.gather(geometry, foot, foot_points, areas);
+        Ok(())
+    }
+
+    /// The foot points and gaps of the current quadrature points at a new
+    /// configuration, the segmentation held (what the tangent differentiates, see
+    /// `PairSolver::hold_segmentation`; the finite-difference checks use it too).
+    /// `x_net` must already be in `geometry`. A point whose projection now fails is
+    /// dropped.
+    pub fn refresh(&mut self, geometry: &Projector, x_net: &[Vec3], x_slave: &[Vec3], foot: &[Projection], foot_points: &[SurfacePoint], areas: &[f64]) -> Result<(), SplineError> {
+        self.trace.update(x_net)?;
+        let trace = &self.trace;
+        self.points.par_iter_mut().zip(self.faces.par_iter()).with_min_len(16).for_each(|(pts, face)| {
+            let xf = face.map(|s| x_slave[s as usize]);
+            pts.retain_mut(|p| {
+                let x: Vec3 = (0..4).map(|l| xf[l] * p.n[l]).sum();
+                match project_point(geometry, trace, &x, p.cell, Some(p.xi)) {
+                    Some((xi, zeta, g)) => {
+                        (p.xi, p.zeta, p.g) = (xi, zeta, g);
+                        true
+                    }
+                    None => false,
+                }
+            });
+        });
+        self.gather(geometry, foot, foot_points, areas);
+        Ok(())
+    }
+
+    /// ĝ_s, the covered area and the element's nodes of every slave from the
+    /// quadrature points.
+    fn gather(&mut self, geometry: &Projector, foot: &[Projection], foot_points: &[SurfacePoint], areas: &[f64]) {
+        let na = self.na;
+        let (faces, faces_of, points, net, slaves, duals) = (&self.faces, &self.faces_of, &self.points, &self.net, &self.slaves, &self.duals);
         self.gap
             .par_iter_mut()
             .zip(self.covered.par_iter_mut())
@@ -290,7 +341,7 @@ impl Mortar {
                     let face = faces[f as usize];
                     let Some(l) = face.iter().position(|&c| c as usize == s) else { continue };
                     for p in &points[f as usize] {
-                        let c = p.w * p.n[l];
+                        let c = p.w * dual_shape(&duals[f as usize], l, &p.n);
                         gw += c * p.g;
                         cw += c;
                         nodes.extend(geometry.evaluate(p.xi, Some(p.cell)).basis.nodes().iter().map(|&k| net[k]));
@@ -311,34 +362,39 @@ impl Mortar {
                 *covered = cw;
                 *gap = if cw > 0.0 { gw / areas[s] } else { f64::INFINITY };
             });
-        Ok(())
     }
 }
 
-impl Mortar {
-    /// The foot points and gaps of the current quadrature points at a new
-    /// configuration, the segmentation held (what the tangent differentiates; the
-    /// finite-difference checks use it). `x_net` must already be in `geometry`.
-    pub fn refresh(&mut self, geometry: &Projector, x_net: &[Vec3], x_slave: &[Vec3], areas: &[f64]) -> Result<(), SplineError> {
-        self.trace.update(x_net)?;
-        for f in 0..self.faces.len() {
-            let xf = self.faces[f].map(|s| x_slave[s as usize]);
-            for p in &mut self.points[f] {
-                let x: Vec3 = (0..4).map(|l| xf[l] * p.n[l]).sum();
-                let (xi, zeta, g) = project_point(geometry, &self.trace, &x, p.cell, Some(p.xi)).unwrap_or((p.xi, p.zeta, f64::NAN));
-                (p.xi, p.zeta, p.g) = (xi, zeta, g);
+/// The dual (biorthogonal) basis of a bilinear face (Wohlmuth 2000; Popp et al.
+/// 2010): Φ_i = Σ_j a_ij N_j with ∫_f Φ_i N_j dA₀ = δ_ij ∫_f N_j dA₀, so
+/// `a = D M⁻¹`, M_ij = ∫ N_i N_j dA₀, D = diag(∫ N_i dA₀) (3 × 3 Gauss: exact for
+/// the degree ≤ 3 integrands of a bilinear face). Σ_i Φ_i = 1, so a uniform traction
+/// stays uniform (the patch test), and the slave node s feels only its own
+/// multiplier: ∫ Φ_s N_j = δ_sj A_j, the coupling of node-to-surface, which keeps the
+/// Uzawa updates as fast as there (standard multipliers couple neighbours through
+/// M, and the mesh-scale oscillating modes of λ converge slowly).
+pub fn dual_basis(x: &[Vec3; 4]) -> [[f64; 4]; 4] {
+    const G3: [(f64, f64); 3] = [(-0.774_596_669_241_483_4, 5.0 / 9.0), (0.0, 8.0 / 9.0), (0.774_596_669_241_483_4, 5.0 / 9.0)];
+    let mut m = nalgebra::Matrix4::<f64>::zeros();
+    for (s, ws) in G3 {
+        for (t, wt) in G3 {
+            let (n, _) = quad4([s, t]);
+            let w = ws * wt * face_jacobian(x, [s, t]);
+            for i in 0..4 {
+                for j in 0..4 {
+                    m[(i, j)] += w * n[i] * n[j];
+                }
             }
         }
-        for s in 0..self.gap.len() {
-            let mut gw = 0.0;
-            for &f in &self.faces_of[s] {
-                let Some(l) = self.faces[f as usize].iter().position(|&c| c as usize == s) else { continue };
-                gw += self.points[f as usize].iter().map(|p| p.w * p.n[l] * p.g).sum::<f64>();
-            }
-            self.gap[s] = if self.covered[s] > 0.0 { gw / areas[s] } else { f64::INFINITY };
-        }
-        Ok(())
     }
+    let d = nalgebra::Matrix4::from_diagonal(&nalgebra::Vector4::from_fn(|i, _| m.row(i).sum()));
+    let a = d * m.try_inverse().unwrap_or_else(nalgebra::Matrix4::identity);
+    std::array::from_fn(|i| std::array::from_fn(|j| a[(i, j)]))
+}
+
+/// Φ_l = Σ_j a_lj N_j.
+fn dual_shape(a: &[[f64; 4]; 4], l: usize, n: &[f64; 4]) -> f64 {
+    (0..4).map(|j| a[l][j] * n[j]).sum()
 }
 
 /// The control points `[x_00, x_10, x_01, x_11]` of net cell `cell` (the order of
