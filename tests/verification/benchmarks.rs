@@ -82,9 +82,10 @@ fn staged_hertz_linear(integration: &str) -> tempfile::TempDir {
 /// force per tributary area. Measured (2026-11-25): node RMS 0.01055, max 0.03778;
 /// mortar RMS 0.04491, max 0.13475, force per area 0.02956; the max at the last
 /// active node x = 0.631 (b = 0.683) in both. Pinned to ±2 %: the solution is
-/// converged far tighter (penetration < 1e-6 against a 0.06 element, Newton to
-/// round-off), so only a change of the method (integration, edge, active set, load)
-/// moves them by that much; it is then to be measured again, not loosened.
+/// converged far tighter (penetration < 1e-6 against a 0.06 element, Newton's
+/// relative residual 1e-8), so only a change of the method (integration, edge,
+/// active set, load) moves them by that much; it is then to be measured again, not
+/// loosened (a pin moved by 4 % makes it fail, checked).
 /// At this refinement mortar is NOT below node-to-surface (4.3 × in RMS, 2.8 × by the
 /// force per area; at refine 4 the two are equal, docs), and the test asserts that
 /// relation too: when mortar's error drops below node's it fails, and the doc's
