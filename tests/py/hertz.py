@@ -32,6 +32,28 @@ Definitions (the mesh: half cylinder x >= 0, one element layer in z, thickness t
   element); h_master: the master (block_top) element length at x = 0.
 - newton: Newton corrections (linear solves) summed over increments, from the CSV;
   augmentations: augmentation passes summed over increments.
+- Profile error (the whole pressure distribution, not just p0 and b): on the same
+  slave line and the same REFERENCE x (the abscissa on which the nodal pressures
+  integrate to P, and the undeformed coordinate of Hertz's linear theory), the
+  nodal error e_i = (p_fe(x_i) - p_hertz(x_i)) / p0_hertz with
+  p_hertz(x) = p0_hertz sqrt(1 - x^2/b_hertz^2) for x < b_hertz, 0 beyond (b_hertz,
+  p0_hertz of the measured P). Over the window x <= 2 b_hertz (the contact zone and as
+  much of the open zone next to it, the same physical window at every refinement):
+  profile_rms_err = sqrt(mean_i e_i^2) over its nodes, profile_l2_err =
+  sqrt(int e^2 dx / x_last) over [x_0 = 0, x_last] (the window's first and last
+  node), by the trapezoid rule on the nodal errors (weights the graded nodes by their
+  spacing); profile_max_err = max |e_i| over all the line's
+  nodes and profile_max_x its x; profile_nodes: the window's node count;
+  profile_interior_max_err = max |e_i| over x <= 0.8 b_hertz (away from the edge,
+  where the closed form is smooth).
+- integration: the pair's `integration` (node or mortar, from the setup in the
+  .scres). With mortar, contact_pressure at a slave node is the multiplier t_s, the
+  nodal value of the traction field sum_r t_r N_r; the slave node's contact force is
+  f_s = sum_r t_r int N_r N_s dA (a consistent "mass" M), while node-to-surface's is
+  t_s A_s. profile_force_*_err: the same errors for the nodal force per tributary
+  area, f_s / A_s = (M t)_s / (M 1)_s (M of the line's linear elements on the
+  reference chords: the faces are bilinear and t is the same at z = 0 and z = t, so
+  the z direction cancels); for node-to-surface this is t_s itself.
 """
 import argparse
 import json
@@ -117,6 +139,28 @@ def main():
                       & np.isclose(X[:, 2], z0))[0] if "set:" + a.master_set in m.point_data else []
     h_master = float(np.sort(X[master, 0])[1] - np.sort(X[master, 0])[0]) if len(master) > 1 else None
 
+    # profile error against the closed form, on the reference x (see the docstring)
+    p_h = np.where(xr < b_h, p0_h * np.sqrt(np.clip(1.0 - (xr / b_h) ** 2, 0.0, None)), 0.0)
+    e = (ps - p_h) / p0_h
+    win = xr <= 2.0 * b_h
+    e_w, x_w = e[win], xr[win]
+    prof_rms = float(np.sqrt(np.mean(e_w ** 2)))
+    prof_l2 = float(np.sqrt(np.sum(0.5 * (e_w[1:] ** 2 + e_w[:-1] ** 2) * np.diff(x_w)) / (x_w[-1] - x_w[0])))
+    i_max = int(np.argmax(np.abs(e)))
+    integration = sr.contact_integration(scres)
+    if integration == "mortar":
+        L = np.linalg.norm(np.diff(X[slave][:, :2], axis=0), axis=1)   # reference chords
+        Mt, M1 = np.zeros_like(ps), np.zeros_like(ps)
+        for k, Lk in enumerate(L):
+            Mt[k] += Lk / 6 * (2 * ps[k] + ps[k + 1]); Mt[k + 1] += Lk / 6 * (ps[k] + 2 * ps[k + 1])
+            M1[k] += Lk / 2; M1[k + 1] += Lk / 2
+        pf = Mt / M1
+    else:
+        pf = ps
+    ef = (pf - p_h) / p0_h
+    ef_w = ef[win]
+    i_fmax = int(np.argmax(np.abs(ef)))
+
     conv = sr.convergence(csv_path) if os.path.exists(csv_path) else {}
     out = {
         "vtu": vtu,
@@ -135,6 +179,15 @@ def main():
         "b_fe_current": b_fe_cur, "b_bracket_current": bracket_cur, "b_err_current": b_fe_cur / b_h - 1.0,
         "b_fit_current": b_fit_cur, "b_fit_err_current": b_fit_cur / b_h - 1.0,
         "active_nodes_line": n_act,
+        "profile_rms_err": prof_rms, "profile_l2_err": prof_l2,
+        "profile_max_err": float(abs(e[i_max])), "profile_max_x": float(xr[i_max]),
+        "profile_nodes": int(win.sum()),
+        "profile_interior_max_err": float(np.abs(e[xr <= 0.8 * b_h]).max()),
+        "integration": integration,
+        "profile_force_rms_err": float(np.sqrt(np.mean(ef_w ** 2))),
+        "profile_force_l2_err": float(np.sqrt(np.sum(0.5 * (ef_w[1:] ** 2 + ef_w[:-1] ** 2) * np.diff(x_w))
+                                              / (x_w[-1] - x_w[0]))),
+        "profile_force_max_err": float(abs(ef[i_fmax])), "profile_force_max_x": float(xr[i_fmax]),
         "pressure_z0_z1_mismatch": z_mismatch,
         "max_penetration": float(pair["max_penetration"]),
         "newton": sum(c["corrections"] for c in conv.values()) if conv else None,

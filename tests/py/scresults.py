@@ -116,6 +116,24 @@ def scres_summary(scres):
     return incs
 
 
+def contact_integration(scres, pair=None):
+    """`integration` (node or mortar) of a contact pair (the first, or `pair`) in the
+    solve setup recorded in the .scres (meta.setup; `node` when not given)."""
+    exe = os.environ.get("SC_EXPORT") or shutil.which("sc-export")
+    if not exe:
+        raise SystemExit("sc-export not found: put it on PATH or set SC_EXPORT")
+    text = subprocess.run([exe, scres, "--format", "yaml", "-o", "-"], check=True,
+                          capture_output=True, text=True).stdout
+    setup = text.split("\nmeta_1:")[0].split("  setup: |", 1)[-1]
+    entries = re.split(r"\n\s*- pair: ", setup.split("\n    contact:", 1)[-1])[1:]
+    for e in entries:
+        name = e.split("\n", 1)[0].strip().strip("'\"")
+        if pair is None or name == pair:
+            m = re.search(r"\n\s*integration: (\w+)", e.split("\n    [a-z]", 1)[0])
+            return m.group(1) if m else "node"
+    return "node"
+
+
 def reaction(inc, name):
     for r in inc.get("reactions") or []:
         if r["set"] == name:
