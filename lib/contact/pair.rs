@@ -49,6 +49,8 @@ pub struct PairSettings {
     pub integration: Integration,
     /// Mortar: the multiplier basis.
     pub multipliers: crate::format::setup::MortarMultipliers,
+    /// Mortar: the basis the master receives the forces through.
+    pub transfer: crate::format::setup::MortarTransfer,
 }
 
 impl PairSettings {
@@ -281,7 +283,7 @@ impl PairSolver {
         let mortar = match settings.integration {
             Integration::Node => None,
             Integration::Mortar => Some(
-                Mortar::new(&def.slave_faces, &pair.slave_nodes, x_ref, [a, b], &pair.net.nodes, settings.multipliers)
+                Mortar::new(&def.slave_faces, &pair.slave_nodes, x_ref, [a, b], &pair.net.nodes, settings.multipliers, settings.transfer)
                     .map_err(err)?
                     .map_err(|source| PairError::Mortar { pair: pair.name.clone(), source })?,
             ),
@@ -892,7 +894,7 @@ mod tests {
             slave_nodes: (30..70).collect(),
             net: ControlNet { a, b, nodes: (0..30).collect() },
         };
-        let settings = PairSettings { eps_n: 1e3, enforcement: Enforcement::Penalty, penetration_tolerance: 1e-3, max_augmentations: 0, update_halvings: 0, mu: 0.0, eps_t: 0.0, stabilization: 0.0, integration: Integration::Node, multipliers: Default::default() };
+        let settings = PairSettings { eps_n: 1e3, enforcement: Enforcement::Penalty, penetration_tolerance: 1e-3, max_augmentations: 0, update_halvings: 0, mu: 0.0, eps_t: 0.0, stabilization: 0.0, integration: Integration::Node, multipliers: Default::default(), transfer: Default::default() };
         let def = ContactDefinition { pair, settings, areas: vec![0.01; 40], slave_faces: Vec::new(), h_master: 0.2, eps_n_default: false, adjust: None, allow_flipped_master: false };
         let solver = PairSolver::new(&def, &x).unwrap();
         (x, solver)

@@ -447,6 +447,21 @@ pub enum MortarMultipliers {
     Dual,
 }
 
+/// Through which basis a mortar pair's master receives the contact forces
+/// (`contact::mortar`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum MortarTransfer {
+    /// The master body's facets (its own hex8 faces): the consistent nodal forces of
+    /// a uniform pressure, the contact patch test exact with every master.
+    #[default]
+    Trace,
+    /// The master surface's basis (the B-spline's Q_A, eq. 6.2): the variation of the
+    /// gap, a symmetric tangent and smoother force histories in sliding; the patch
+    /// test is exact only with facets.
+    Surface,
+}
+
 /// Contact settings of one pair of the `.sccontact` model (by its name).
 #[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
@@ -466,6 +481,9 @@ pub struct ContactSetup {
     /// Mortar integration: the multiplier basis, `standard` (default) or `dual`.
     #[serde(default, skip_serializing_if = "is_standard")]
     pub multipliers: MortarMultipliers,
+    /// Mortar integration: `trace` (default) or `surface`.
+    #[serde(default, skip_serializing_if = "is_trace")]
+    pub transfer: MortarTransfer,
     /// Largest accepted penetration −g_N (a length), augmented Lagrangian only.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub penetration_tolerance: Option<f64>,
@@ -501,6 +519,10 @@ pub struct ContactSetup {
     /// (`check::orientation`); without it such a pair is refused.
     #[serde(default, skip_serializing_if = "is_false")]
     pub allow_flipped_master: bool,
+}
+
+fn is_trace(v: &MortarTransfer) -> bool {
+    *v == MortarTransfer::Trace
 }
 
 fn is_standard(v: &MortarMultipliers) -> bool {

@@ -84,7 +84,7 @@ impl ContactDefinition {
     /// B-spline master (geometry from the patch, forces through the facet trace of
     /// the segment's cell, `contact::mortar`) make it non-symmetric.
     pub fn symmetric_tangent(&self) -> bool {
-        let trace_is_geometry = self.pair.master_kind == MasterKind::Facet;
+        let trace_is_geometry = self.pair.master_kind == MasterKind::Facet || self.settings.transfer == crate::format::setup::MortarTransfer::Surface;
         !self.settings.frictional() && (self.settings.integration == Integration::Node || trace_is_geometry)
     }
 }
@@ -220,7 +220,7 @@ fn contact_definitions(mesh: &Mesh, pairs: &[ContactPair], setup: &SolveSetup, f
         };
         out.push(ContactDefinition {
             pair: pair.clone(),
-            settings: PairSettings { eps_n, enforcement: c.enforcement, penetration_tolerance, max_augmentations: c.max_augmentations, update_halvings: c.update_halvings, mu: c.mu, eps_t, stabilization: c.stabilization, integration: c.integration, multipliers: c.multipliers },
+            settings: PairSettings { eps_n, enforcement: c.enforcement, penetration_tolerance, max_augmentations: c.max_augmentations, update_halvings: c.update_halvings, mu: c.mu, eps_t, stabilization: c.stabilization, integration: c.integration, multipliers: c.multipliers, transfer: c.transfer },
             eps_n_default,
             areas,
             slave_faces,

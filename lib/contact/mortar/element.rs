@@ -22,7 +22,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::{cell_nodes, Mortar};
+use super::{Mortar, Transfer};
 use crate::contact::element::{ContactElementError, ContactState, NormalLaw};
 use crate::contact::friction::{tangential_contact, FrictionLaw};
 use crate::contact::master::Projector;
@@ -97,7 +97,8 @@ pub fn mortar_contact(mortar: &Mortar, s: usize, geometry: &Projector, x_slave: 
     let net = mortar.net_nodes();
     let slaves = mortar.slave_nodes();
     let at = |node: u32| 3 * nodes.binary_search(&node).expect("element node list holds every node it couples");
-    let facet_master = matches!(geometry, Projector::Facet(_));
+    // the master's own basis carries the forces: facets, or `transfer: surface`
+    let own_basis = matches!(geometry, Projector::Facet(_)) || mortar.transfer == Transfer::Surface;
     let mut rows = Rows::new(m);
     let (mut big_g, mut big_v) = (DVector::zeros(m), DVector::zeros(m));
     let mut h = DMatrix::zeros(m, m);
@@ -155,17 +156,16 @@ pub fn mortar_contact(mortar: &Mortar, s: usize, geometry: &Projector, x_slave: 
                 }
             }
             // the trace: the facet of the segment's cell at ζ̄
-            let spf = if facet_master { sp } else { mortar.trace().evaluate_in_cell(p.zeta, p.cell) };
+            let spf = if own_basis { sp } else { mortar.trace().evaluate_in_cell(p.zeta, p.cell) };
             let qf = spf.basis.q();
             let qfa = spf.basis.q_alpha();
-            let f_at: Vec<usize> = cell_nodes(mortar.na, p.cell).iter().map(|&kk| at(net[kk])).collect();
-            debug_assert_eq!(spf.basis.nodes(), &cell_nodes(mortar.na, p.cell));
+            let f_at: Vec<usize> = spf.basis.nodes().iter().map(|&kk| at(net[kk])).collect();
             for (a, &j) in f_at.iter().enumerate() {
                 for cc in 0..3 {
                     vgrad[j + cc] -= qf[a] * n[cc];
                 }
             }
-            if facet_master {
+            if own_basis {
                 dzeta[0].copy_from(&dxi[0]);
                 dzeta[1].copy_from(&dxi[1]);
             } else {
@@ -246,7 +246,7 @@ pub fn mortar_contact(mortar: &Mortar, s: usize, geometry: &Projector, x_slave: 
 mod tests {
     use super::*;
     use crate::contact::element::tests::curved_net;
-    use crate::contact::mortar::Multipliers;
+    use crate::contact::mortar::{Multipliers, Transfer};
     use crate::fem::fd::{fd_jacobian, rel_err, FdStep};
     use crate::spline::{BSplinePatch, BSplineProjector, FacetProjector, FacetSurface};
 
@@ -289,12 +289,21 @@ mod tests {
     /// there (FD truncation and round-off ~1e-9).
     #[test]
     fn tangent_matches_finite_differences() {
-        for (order, multipliers) in [(0, Multipliers::Standard), (2, Multipliers::Standard), (3, Multipliers::Standard), (4, Multipliers::Standard), (0, Multipliers::Dual), (3, Multipliers::Dual)] {
+        for (order, multipliers, transfer) in [
+            (0, Multipliers::Standard, Transfer::Trace),
+            (2, Multipliers::Standard, Transfer::Trace),
+            (3, Multipliers::Standard, Transfer::Trace),
+            (4, Multipliers::Standard, Transfer::Trace),
+            (0, Multipliers::Dual, Transfer::Trace),
+            (3, Multipliers::Dual, Transfer::Trace),
+            (3, Multipliers::Standard, Transfer::Surface),
+            (4, Multipliers::Dual, Transfer::Surface),
+        ] {
             let (x_net, x_slave, faces, net, slaves) = setup(order);
             let mut x_all: Vec<Vec3> = x_net.clone();
             x_all.extend(&x_slave);
             let mut pr = projector(order, &x_net);
-            let mut mortar = Mortar::new(&faces, &slaves, &x_all, [NA, NB], &net, multipliers).unwrap().unwrap();
+            let mut mortar = Mortar::new(&faces, &slaves, &x_all, [NA, NB], &net, multipliers, transfer).unwrap().unwrap();
             let foot: Vec<_> = x_slave.iter().map(|x| pr.project(x, None)).collect();
             let foot_points: Vec<_> = foot.iter().map(|(p, c)| pr.evaluate(p.xi, *c)).collect();
             let foot: Vec<_> = foot.into_iter().map(|(p, _)| p).collect();
@@ -353,9 +362,9 @@ mod tests {
                 );
                 pr.update(&x_net).unwrap();
                 let e = rel_err(k.as_slice(), k_fd.as_slice());
-                eprintln!("mortar order {order} {multipliers:?} (λ {lambda}, ε {eps}, friction {fric:?}): |K − K_fd| / |K| = {e:.2e}, {} nodes", nodes.len());
+                eprintln!("mortar order {order} {multipliers:?} {transfer:?} (λ {lambda}, ε {eps}, friction {fric:?}): |K − K_fd| / |K| = {e:.2e}, {} nodes", nodes.len());
                 assert!(e < 1e-6, "order {order} (λ {lambda}, ε {eps}, friction {fric:?}): relative error {e:e}");
-                if order == 0 && fric.is_none() {
+                if (order == 0 || transfer == Transfer::Surface) && fric.is_none() {
                     let asym = (&k - k.transpose()).abs().max() / k.abs().max();
                     assert!(asym < 1e-10, "facet master: K symmetric (the Hessian of ĝ), found {asym:e}");
                 }
@@ -378,6 +387,7 @@ mod tests {
             covered: m.covered.clone(),
             nodes: m.nodes.clone(),
             skipped_cells: m.skipped_cells,
+            transfer: m.transfer,
             net: m.net.clone(),
             slaves: m.slaves.clone(),
         }

@@ -43,6 +43,7 @@ use super::master::Projector;
 use crate::spline::{FacetProjector, FacetSurface, Projection, SplineError, SurfacePoint, Vec3};
 
 pub use crate::format::setup::MortarMultipliers as Multipliers;
+pub use crate::format::setup::MortarTransfer as Transfer;
 
 const IDENTITY: [[f64; 4]; 4] = [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]];
 
@@ -93,6 +94,8 @@ pub struct Mortar {
     nodes: Vec<Vec<u32>>,
     /// Cells skipped because their image in a slave face was not convex.
     pub skipped_cells: usize,
+    /// Through which basis the master receives the forces.
+    pub transfer: Transfer,
     /// Mesh node of every control point, and of every slave.
     net: Vec<u32>,
     slaves: Vec<u32>,
@@ -111,7 +114,7 @@ impl Mortar {
     /// `faces`: the slave faces as mesh node ids (cycle order); `slaves`: the pair's
     /// slave nodes (sorted); `x_ref`: reference coordinates of all mesh nodes;
     /// `net_dims`, `net`: the master control net's size and mesh nodes.
-    pub fn new(faces: &[[u32; 4]], slaves: &[u32], x_ref: &[Vec3], net_dims: [usize; 2], net: &[u32], multipliers: Multipliers) -> Result<Result<Self, MortarError>, SplineError> {
+    pub fn new(faces: &[[u32; 4]], slaves: &[u32], x_ref: &[Vec3], net_dims: [usize; 2], net: &[u32], multipliers: Multipliers, transfer: Transfer) -> Result<Result<Self, MortarError>, SplineError> {
         let x_net: Vec<Vec3> = net.iter().map(|&n| x_ref[n as usize]).collect();
         let x_net = &x_net[..];
         let trace = FacetProjector::new(FacetSurface::new(net_dims[0], net_dims[1])?, x_net)?;
@@ -152,6 +155,7 @@ impl Mortar {
             covered: vec![0.0; n],
             nodes: vec![Vec::new(); n],
             skipped_cells: 0,
+            transfer,
             net: net.to_vec(),
             slaves: slaves.to_vec(),
         }))
@@ -327,7 +331,7 @@ impl Mortar {
     /// quadrature points.
     fn gather(&mut self, geometry: &Projector, foot: &[Projection], foot_points: &[SurfacePoint], areas: &[f64]) {
         let na = self.na;
-        let (faces, faces_of, points, net, slaves, duals) = (&self.faces, &self.faces_of, &self.points, &self.net, &self.slaves, &self.duals);
+        let (faces, faces_of, points, net, slaves, duals, transfer) = (&self.faces, &self.faces_of, &self.points, &self.net, &self.slaves, &self.duals, self.transfer);
         self.gap
             .par_iter_mut()
             .zip(self.covered.par_iter_mut())
@@ -345,7 +349,9 @@ impl Mortar {
                         gw += c * p.g;
                         cw += c;
                         nodes.extend(geometry.evaluate(p.xi, Some(p.cell)).basis.nodes().iter().map(|&k| net[k]));
-                        nodes.extend(cell_nodes(na, p.cell).iter().map(|&k| net[k]));
+                        if transfer == Transfer::Trace {
+                            nodes.extend(cell_nodes(na, p.cell).iter().map(|&k| net[k]));
+                        }
                     }
                     if !points[f as usize].is_empty() {
                         nodes.extend(face.iter().map(|&c| slaves[c as usize]));
