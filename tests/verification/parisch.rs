@@ -162,4 +162,12 @@ fn parisch_under_mortar_agrees() {
     assert!((inc.info.contact[0].force[2] - F).abs() < 1e-8 * F, "{:?}", inc.info.contact[0]);
     assert_eq!(p.len(), 9);
     assert!(p.iter().all(|&v| (v - 5000.0).abs() < 1.0), "{p:?}");
+    // the slave surface series of the export: per node and per face pressure
+    let out = dir.path().join("pipelines/out");
+    let series = std::fs::read_to_string(out.join("parisch_contact_slave.pvd")).unwrap();
+    assert_eq!(series.matches("<DataSet").count(), 2, "{series}");
+    let last = std::fs::read_to_string(out.join("parisch_contact_slave_1.vtu")).unwrap();
+    for field in ["contact_pressure", "contact_pressure_face", "gmsh_node_tag"] {
+        assert!(last.contains(&format!("Name=\"{field}\"")), "{field} missing from the slave surface");
+    }
 }
