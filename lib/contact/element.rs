@@ -90,6 +90,20 @@ impl MasterSurface<'_> {
     }
 }
 
+/// `r` and `k` zeroed at size `m` and `m × m` (storage kept when the size fits).
+pub(crate) fn zero_element(r: &mut DVector<f64>, k: &mut DMatrix<f64>, m: usize) {
+    if r.len() != m {
+        *r = DVector::zeros(m);
+    } else {
+        r.fill(0.0);
+    }
+    if k.shape() != (m, m) {
+        *k = DMatrix::zeros(m, m);
+    } else {
+        k.fill(0.0);
+    }
+}
+
 /// The first `m` entries of a stack buffer as a vector view.
 fn view(v: &[f64; MAX_DOFS], m: usize) -> DVectorView<'_, f64> {
     DVectorView::from_slice(&v[..m], m)
@@ -112,16 +126,7 @@ pub fn normal_contact(
 ) -> Result<ContactState, ContactElementError> {
     let nc = sp.basis.len();
     let m = 3 * (1 + nc);
-    if r.len() != m {
-        *r = DVector::zeros(m);
-    } else {
-        r.fill(0.0);
-    }
-    if k.shape() != (m, m) {
-        *k = DMatrix::zeros(m, m);
-    } else {
-        k.fill(0.0);
-    }
+    zero_element(r, k, m);
     let n = sp.n_bar;
     let g = (xs - sp.x_bar).dot(&n); // eq. 4.3
     let trial = law.lambda_n + law.eps_n * g; // eq. 4.2

@@ -140,15 +140,29 @@ fn paraview_renders_the_crossed_beams() {
     let s = steps(&r);
     for (field, coloured) in [("contact_pressure", 0.002), ("von_mises", 0.05)] {
         let png = out.join(format!("{field}.png"));
-        let o = Command::new("xvfb-run")
-            .args(["-a", "pvbatch"])
-            .arg(repo().join("docs/scripts/render.py"))
-            .arg(out.join("crossed_beams.pvd"))
-            .arg("-o")
-            .arg(&png)
-            .args(["--field", field])
-            .output()
-            .expect("xvfb-run runs");
+        // xvfb-run -a starts looking for a free display at :99, and two runs started
+        // together (two checkouts testing on one machine) race for it ("bad X server
+        // connection"): start from a display number of our own, and try again if the
+        // X server still did not come up
+        let render = |attempt: u32| {
+            let display = (100 + (std::process::id() % 400) * 2 + attempt * 800).to_string();
+            Command::new("xvfb-run")
+                .args(["-a", "-n", &display, "pvbatch"])
+                .arg(repo().join("docs/scripts/render.py"))
+                .arg(out.join("crossed_beams.pvd"))
+                .arg("-o")
+                .arg(&png)
+                .args(["--field", field])
+                .output()
+                .expect("xvfb-run runs")
+        };
+        let mut o = render(0);
+        for attempt in 1..3 {
+            if o.status.success() || !String::from_utf8_lossy(&o.stderr).contains("X server") {
+                break;
+            }
+            o = render(attempt);
+        }
         let stdout = String::from_utf8_lossy(&o.stdout);
         assert!(o.status.success(), "render.py --field {field}: {stdout}{}", String::from_utf8_lossy(&o.stderr));
         let line = stdout.lines().rev().find(|l| l.starts_with('{')).expect("render.py's JSON line");

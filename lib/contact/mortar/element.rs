@@ -23,7 +23,7 @@
 use nalgebra::{DMatrix, DVector};
 
 use super::{Mortar, Transfer};
-use crate::contact::element::{ContactElementError, ContactState, NormalLaw};
+use crate::contact::element::{zero_element, ContactElementError, ContactState, NormalLaw};
 use crate::contact::friction::{tangential_contact, FrictionLaw};
 use crate::contact::master::Projector;
 use crate::spline::{SurfacePoint, Vec3};
@@ -78,16 +78,7 @@ pub struct NodeFriction<'a> {
 pub fn mortar_contact(mortar: &Mortar, s: usize, geometry: &Projector, x_slave: &[Vec3], law: &NormalLaw, friction: Option<NodeFriction<'_>>, r: &mut DVector<f64>, k: &mut DMatrix<f64>) -> Result<ContactState, ContactElementError> {
     let nodes = mortar.element_nodes(s);
     let m = 3 * nodes.len();
-    if r.len() != m {
-        *r = DVector::zeros(m);
-    } else {
-        r.fill(0.0);
-    }
-    if k.shape() != (m, m) {
-        *k = DMatrix::zeros(m, m);
-    } else {
-        k.fill(0.0);
-    }
+    zero_element(r, k, m);
     let g_hat = mortar.gap[s];
     let trial = law.lambda_n + law.eps_n * g_hat;
     let touching = trial <= law.eps_n * law.touch;
