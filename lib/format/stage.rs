@@ -564,7 +564,7 @@ impl StageFile {
             writeln!(out, "    dtype: {}", a.data.dtype().name())?;
             writeln!(out, "    shape: {:?}", a.dims)?;
             writeln!(out, "    data:")?;
-            let cols = if a.dims.len() >= 2 { a.dims[1..].iter().product::<u64>() as usize } else { 1 };
+            let cols = if a.dims.len() >= 2 { a.dims[1..].iter().try_fold(1u64, |p, &d| p.checked_mul(d)).unwrap_or(0) as usize } else { 1 };
             let rows = a.data.len().checked_div(cols).unwrap_or(0);
             for r in 0..rows {
                 let range = r * cols..(r + 1) * cols;

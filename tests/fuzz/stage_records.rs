@@ -188,6 +188,55 @@ fn mutate_array(r: &mut Record, names: &[Vec<u8>], rng: &mut Rng) {
     }
 }
 
+/// The same count in a META number and an array dimension (payload resized when
+/// small): the lie a reader's cross-checks between metadata and arrays let through
+/// (a net of 10^12 x 0 points against an empty array).
+fn lie_consistently(s: &mut Stage, rng: &mut Rng) {
+    let v: u64 = *rng.pick(&[0, 1, 2, 3, 4, 9, 1 << 20, 1 << 32, 1_000_000_000_000, u64::MAX]);
+    let metas: Vec<(usize, usize)> = s.segments.iter().enumerate().flat_map(|(k, sg)| sg.iter().enumerate().filter(|(_, r)| matches!(r, Record::Meta(_))).map(move |(i, _)| (k, i))).collect();
+    let arrays: Vec<(usize, usize)> = s.segments.iter().enumerate().flat_map(|(k, sg)| sg.iter().enumerate().filter(|(_, r)| matches!(r, Record::Array { .. })).map(move |(i, _)| (k, i))).collect();
+    if metas.is_empty() || arrays.is_empty() {
+        return;
+    }
+    let &(mk, mi) = rng.pick(&metas);
+    if let Record::Meta(t) = &mut s.segments[mk][mi] {
+        let nums: Vec<(usize, usize)> = {
+            let mut out = Vec::new();
+            let mut i = 0;
+            while i < t.len() {
+                if t[i].is_ascii_digit() && (i == 0 || !t[i - 1].is_ascii_alphanumeric()) {
+                    let st = i;
+                    while i < t.len() && t[i].is_ascii_digit() {
+                        i += 1;
+                    }
+                    out.push((st, i));
+                } else {
+                    i += 1;
+                }
+            }
+            out
+        };
+        if nums.is_empty() {
+            return;
+        }
+        let (a, b) = *rng.pick(&nums);
+        *t = [&t[..a], v.to_string().as_bytes(), &t[b..]].concat();
+    }
+    let &(ak, ai) = rng.pick(&arrays);
+    if let Record::Array { dtype, dims, payload, .. } = &mut s.segments[ak][ai] {
+        if dims.is_empty() {
+            dims.push(v);
+        } else {
+            let i = rng.below(dims.len());
+            dims[i] = v;
+        }
+        let n = dims.iter().try_fold(1u64, |a, &d| a.checked_mul(d)).and_then(|n| n.checked_mul(dtype_size(*dtype).unwrap_or(1) as u64));
+        if let Some(n) = n.filter(|&n| n <= 1 << 20) {
+            payload.resize(n as usize, 0);
+        }
+    }
+}
+
 /// One structural mutation of a stage file, sealed again; `None` when the input
 /// has no header line (the caller mutates its bytes instead).
 pub fn mutate_stage(b: &[u8], rng: &mut Rng) -> Option<Vec<u8>> {
@@ -214,6 +263,7 @@ pub fn mutate_stage(b: &[u8], rng: &mut Rng) -> Option<Vec<u8>> {
                 let i = rng.below(seg_len);
                 mutate_array(&mut s.segments[k][i], &names, rng);
             }
+            6 if rng.one_in(2) => lie_consistently(&mut s, rng),
             6 if seg_len > 0 => {
                 s.segments[k].remove(rng.below(seg_len));
             }
