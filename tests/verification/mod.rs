@@ -8,5 +8,6 @@ mod ironing;
 mod shallow_ironing;
 mod sliding;
 mod ccx_compare;
+mod determinism;
 #[cfg(feature = "petsc")]
 mod petsc;
