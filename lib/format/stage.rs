@@ -676,6 +676,7 @@ pub fn write_atomic_with(path: &Path, f: impl FnOnce(&mut dyn Write) -> io::Resu
         }
         OutputKind::Regular { target } => target,
     };
+    remove_stale_temporaries(&target);
     let tmp = temp_path(&target);
     let file = fs::File::create(&tmp).map_err(io_err("create its temporary file in the same folder"))?;
     let result = (|| -> io::Result<()> {
@@ -693,6 +694,31 @@ pub fn write_atomic_with(path: &Path, f: impl FnOnce(&mut dyn Write) -> io::Resu
         let _ = fs::remove_file(&tmp);
         StageError::Io { path: shown, action: "rename the temporary file onto", source: e }
     })
+}
+
+/// Remove the temporaries of `target` (`.name.<pid>.tmp`) that a killed writer left:
+/// those whose process no longer runs (Linux: no `/proc/<pid>`). A live writer's
+/// temporary, another program's file, or anything elsewhere is never touched.
+fn remove_stale_temporaries(target: &Path) {
+    if !Path::new("/proc/self").exists() {
+        return;
+    }
+    let Some(name) = target.file_name().map(|n| n.to_string_lossy().into_owned()) else { return };
+    let dir = match target.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let prefix = format!(".{name}.");
+    let Ok(entries) = fs::read_dir(&dir) else { return };
+    for e in entries.flatten() {
+        let file = e.file_name().to_string_lossy().into_owned();
+        let pid = file.strip_prefix(&prefix).and_then(|r| r.strip_suffix(".tmp")).and_then(|p| p.parse::<u32>().ok());
+        if let Some(pid) = pid {
+            if pid != std::process::id() && !Path::new(&format!("/proc/{pid}")).exists() {
+                let _ = fs::remove_file(e.path());
+            }
+        }
+    }
 }
 
 /// `dir/.name.<pid>.tmp` beside the target (same file system, so rename is atomic).
