@@ -18,6 +18,7 @@ pub mod gmres;
 pub mod increments;
 pub mod linear;
 pub mod log;
+pub mod memory;
 pub mod newton;
 pub mod ordering;
 #[cfg(feature = "petsc")]
