@@ -8,10 +8,10 @@
 //! numeric phase's workspace and update matrices, plus the assembled matrix (values
 //! and indices) and the per-unknown vectors. The 1.25 is a margin over a
 //! measurement on the 2-core reference machine: an LDLT with 558 M values in L
-//! (4.5 GB, 201,720 unknowns) peaked at 5.1 GB resident, 1.15 times the factor
-//!. An LU factor (friction's fallback) is not sized before its numeric phase
-//! (partial pivoting decides its fill); it is usually 2–4 times the Cholesky factor
-//! (docs/performance.md).
+//! (4.5 GB, 201,720 unknowns) peaked at 5.1 GB resident, 1.15 times the factor.
+//! An LU factor (friction's fallback) is not sized before its numeric phase
+//! (partial pivoting decides its fill) and is not checked; on the reference machine
+//! it took 4 to 5 times the memory of the Cholesky factor of the same matrix.
 //!
 //! What is available: `SC_MEMORY_LIMIT` (bytes, with an optional `K`, `M` or `G`
 //! suffix, powers of 1024) when set, else `MemAvailable` of `/proc/meminfo`; where
