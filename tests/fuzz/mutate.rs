@@ -108,10 +108,10 @@ fn nudge(t: &[u8], rng: &mut Rng) -> Option<Vec<u8>> {
     let s = std::str::from_utf8(t).ok()?;
     if let Ok(v) = s.parse::<i128>() {
         let n = match rng.below(5) {
-            0 => v + 1,
-            1 => v - 1,
-            2 => v * 10,
-            3 => -v,
+            0 => v.wrapping_add(1),
+            1 => v.wrapping_sub(1),
+            2 => v.wrapping_mul(10),
+            3 => v.wrapping_neg(),
             _ => return Some(format!("{s}000000").into_bytes()),
         };
         return Some(n.to_string().into_bytes());
