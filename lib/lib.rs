@@ -15,6 +15,7 @@
 //! | `check`  | the pre-solve check: contact pairs at the start (projections, gaps, flipped masters, adjust), rigid-body modes |
 //! | `stages` | each pipeline stage as a library call (the binaries are thin wrappers) |
 //! | `pipeline` | the YAML pipeline runner |
+//! | `folder_lock` | one pipeline at a time per output folder (a lock file naming its owner) |
 //!
 //! ## Notation (paper symbol ↔ Rust name ↔ equation)
 //! | paper | Rust | eq. |
@@ -32,6 +33,7 @@ pub mod assembly;
 pub mod check;
 pub mod contact;
 pub mod fem;
+pub mod folder_lock;
 pub mod format;
 pub mod material;
 pub mod mesh;

@@ -3,6 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::folder_lock::FolderLock;
 use crate::format::pipeline::{resolve, Pipeline, PipelineError, Stage};
 use crate::format::setup::SolveSetup;
 use crate::solver::log::Verbosity;
@@ -40,11 +41,27 @@ fn stage_setup(path: &Path, base: &Path, kind: &str, index: usize, inline: &Opti
     }
 }
 
-fn ensure_parent(p: &Path) -> Result<(), StageRunError> {
-    match p.parent() {
-        Some(d) if !d.as_os_str().is_empty() && !d.exists() => std::fs::create_dir_all(d)
-            .map_err(|e| StageRunError::Tool(format!("{}: cannot create folder: {e}", d.display()))),
-        _ => Ok(()),
+/// The output folders a run holds ([`FolderLock`]), taken at the first write into each.
+struct Outputs {
+    pipeline: String,
+    held: Vec<FolderLock>,
+}
+
+impl Outputs {
+    /// Create `p`'s folder if needed and take it for this pipeline.
+    fn ensure_parent(&mut self, p: &Path) -> Result<(), StageRunError> {
+        let d = match p.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d,
+            _ => Path::new("."),
+        };
+        if !d.exists() {
+            std::fs::create_dir_all(d).map_err(|e| StageRunError::Tool(format!("{}: cannot create folder: {e}", d.display())))?;
+        }
+        let canonical = std::fs::canonicalize(d).map_err(|e| StageRunError::Tool(format!("{}: {e}", d.display())))?;
+        if !self.held.iter().any(|l| l.folder == canonical) {
+            self.held.push(FolderLock::acquire(d, &self.pipeline).map_err(|e| StageRunError::Tool(e.to_string()))?);
+        }
+        Ok(())
     }
 }
 
@@ -54,6 +71,7 @@ fn ensure_parent(p: &Path) -> Result<(), StageRunError> {
 pub fn run(path: &Path, verbosity: Verbosity, log: &mut dyn FnMut(&str), warn: &mut dyn FnMut(&str)) -> Result<(), RunError> {
     let pipeline = Pipeline::read(path)?;
     let base: PathBuf = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let mut outputs = Outputs { pipeline: path.display().to_string(), held: Vec::new() };
     let n = pipeline.stages.len();
     if let Some(name) = &pipeline.name {
         log(&format!("pipeline {name}: {n} stages"));
@@ -65,13 +83,13 @@ pub fn run(path: &Path, verbosity: Verbosity, log: &mut dyn FnMut(&str), warn: &
             Stage::Gmsh(s) => {
                 let (geo, out) = (resolve(&base, &s.geo), resolve(&base, &s.output));
                 log(&format!("[{index}/{n}] gmsh {} -> {}", geo.display(), out.display()));
-                ensure_parent(&out).map_err(fail)?;
+                outputs.ensure_parent(&out).map_err(fail)?;
                 stages::gmsh::run_gmsh(&geo, &out, s.format, s.binary).map_err(fail)?;
             }
             Stage::Import(s) => {
                 let (input, out) = (resolve(&base, &s.input), resolve(&base, &s.output));
                 log(&format!("[{index}/{n}] import {} -> {}", input.display(), out.display()));
-                ensure_parent(&out).map_err(fail)?;
+                outputs.ensure_parent(&out).map_err(fail)?;
                 let (mesh, report) = stages::import::import(&input, &out).map_err(fail)?;
                 for line in stages::import::summary(&input, &mesh, &report) {
                     log(&format!("      {line}"));
@@ -83,7 +101,7 @@ pub fn run(path: &Path, verbosity: Verbosity, log: &mut dyn FnMut(&str), warn: &
             Stage::Tag(s) => {
                 let (input, out) = (resolve(&base, &s.input), resolve(&base, &s.output));
                 log(&format!("[{index}/{n}] tag {} -> {}", input.display(), out.display()));
-                ensure_parent(&out).map_err(fail)?;
+                outputs.ensure_parent(&out).map_err(fail)?;
                 for line in stages::tag::tag(&input, &out, &s.pairs).map_err(fail)? {
                     log(&format!("      {line}"));
                 }
@@ -102,7 +120,7 @@ pub fn run(path: &Path, verbosity: Verbosity, log: &mut dyn FnMut(&str), warn: &
                 let written: Vec<String> = [&csv, &vtu, &summary].into_iter().flatten().map(|p| p.display().to_string()).collect();
                 log(&format!("[{index}/{n}] check {}{}", input.display(), if written.is_empty() { String::new() } else { format!(" -> {}", written.join(", ")) }));
                 for p in [&csv, &vtu, &summary].into_iter().flatten() {
-                    ensure_parent(p).map_err(fail)?;
+                    outputs.ensure_parent(p).map_err(fail)?;
                 }
                 let outputs = stages::check::CheckOutputs { csv: csv.as_deref(), vtu: vtu.as_deref(), summary: summary.as_deref() };
                 let r = stages::check::check(&input, &setup, &setup_name, outputs).map_err(fail)?;
@@ -124,7 +142,7 @@ pub fn run(path: &Path, verbosity: Verbosity, log: &mut dyn FnMut(&str), warn: &
             Stage::Solve(s) => {
                 let (input, out) = (resolve(&base, &s.input), resolve(&base, &s.output));
                 log(&format!("[{index}/{n}] solve {} -> {}", input.display(), out.display()));
-                ensure_parent(&out).map_err(fail)?;
+                outputs.ensure_parent(&out).map_err(fail)?;
                 let restart_file = s.restart.as_ref().map(|r| resolve(&base, r));
                 if s.restart_increment.is_some() && restart_file.is_none() {
                     return Err(fail(StageRunError::Usage(format!("{}: solve stage {index}: `restart_increment` needs `restart` (the results file to continue)", path.display()))));
@@ -138,7 +156,7 @@ pub fn run(path: &Path, verbosity: Verbosity, log: &mut dyn FnMut(&str), warn: &
             Stage::Export(s) => {
                 let (input, out) = (resolve(&base, &s.input), resolve(&base, &s.output));
                 log(&format!("[{index}/{n}] export {} -> {}", input.display(), out.display()));
-                ensure_parent(&out).map_err(fail)?;
+                outputs.ensure_parent(&out).map_err(fail)?;
                 let exported = stages::export::export(&input, &out, s.format).map_err(fail)?;
                 log(&format!("      {}", exported.written));
                 for w in &exported.warnings {
@@ -151,7 +169,7 @@ pub fn run(path: &Path, verbosity: Verbosity, log: &mut dyn FnMut(&str), warn: &
                     s.panels.iter().flat_map(|p| p.series.iter().map(|q| resolve(&base, &q.input).display().to_string())).collect();
                 let inputs: Vec<String> = inputs.into_iter().collect();
                 log(&format!("[{index}/{n}] plot {} -> {}", inputs.join(", "), out.display()));
-                ensure_parent(&out).map_err(fail)?;
+                outputs.ensure_parent(&out).map_err(fail)?;
                 let msg = stages::plot::plot(s, &base).map_err(|e| fail(e.into()))?;
                 log(&format!("      {msg}"));
             }

@@ -137,7 +137,9 @@ pub(crate) fn read_pair(f: &StageFile, k: usize, pm: PairMeta, n: usize) -> Resu
     }
     let [a, b] = pm.net;
     let nodes = f.u32s(&rec("net"), Some(a as u64))?.to_vec();
-    if nodes.len() != a * b {
+    // an empty net with a huge side would pass `a · b = 0` and then size the knot
+    // vectors by the metadata alone
+    if a == 0 || b == 0 || a.checked_mul(b) != Some(nodes.len()) {
         return Err(f.invalid(&rec("net"), format!("pair '{}': metadata says a {a} × {b} net, the array holds {} ids", pm.name, nodes.len())));
     }
     if nodes.iter().any(|&v| v as usize >= n) {
@@ -249,6 +251,25 @@ mod tests {
         let bytes = m.encode().unwrap();
         let f = StageFile::parse("c.sccontact", &bytes, Some((FORMAT, MAJOR))).unwrap();
         assert_eq!(ContactModel::from_stage(&f).unwrap(), m);
+    }
+
+    /// Found by reading the code for the fuzzing (every count a reader trusts is
+    /// bounded by the file): a net of 10¹² × 0 points matched its empty array, and the
+    /// knot vectors were then sized by the 10¹² of the metadata.
+    #[test]
+    fn an_empty_net_with_a_huge_side_is_refused() {
+        let m = model();
+        let mut pm = pair_meta(&m.pairs[0]);
+        pm.net = [1_000_000_000_000, 0];
+        let mut w = StageWriter::new(FORMAT, MAJOR, MINOR);
+        w.meta(&serde_yaml::to_string(&PairsMeta { source: "m".into(), pairs: vec![pm] }).unwrap());
+        w.meta(&scmesh::mesh_meta_yaml(&m.mesh, "m"));
+        scmesh::write_mesh_records(&mut w, &m.mesh, "mesh/");
+        w.u32s("pair/0/slave_nodes", &[2], &[0, 1]);
+        w.u32s("pair/0/net", &[0, 1_000_000_000_000], &[]);
+        let f = StageFile::parse("c.sccontact", &w.finish(), Some((FORMAT, MAJOR))).unwrap();
+        let e = ContactModel::from_stage(&f).unwrap_err().to_string();
+        assert!(e.contains("pair/0/net") && e.contains("1000000000000 × 0 net"), "{e}");
     }
 
     #[test]

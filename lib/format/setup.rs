@@ -588,6 +588,11 @@ pub struct SetupError {
     pub message: String,
 }
 
+/// The most equal load steps `increments.count` may ask for: the load factors are
+/// built as a list, and a count no run could reach must be an error, not an
+/// allocation (a setup of a few bytes asking for 10^12 increments).
+pub const MAX_INCREMENTS: u32 = 1_000_000;
+
 impl SolveSetup {
     pub fn parse(path: &str, text: &str) -> Result<Self, SetupError> {
         serde_yaml::from_str(text).map_err(|e| SetupError { path: path.into(), message: e.to_string() })
@@ -614,6 +619,7 @@ impl SolveSetup {
                 }
             }
             (Some(0), None) => Err(err("increments.count must be at least 1".into())),
+            (Some(n), None) if *n > MAX_INCREMENTS => Err(err(format!("increments.count {n} is more than {MAX_INCREMENTS}, the most this build takes (each increment is a nonlinear solve and a segment of the results file)"))),
             (Some(n), None) => {
                 let end = self.increments.end.unwrap_or(1.0);
                 if !(end.is_finite() && end > 0.0) {
@@ -637,6 +643,17 @@ mod tests {
         assert_eq!(s.load_factors("s").unwrap(), vec![0.5, 1.0]);
         assert_eq!(s.linear_solver, LinearSolverChoice::Lu.into());
         assert_eq!(s.constraints[1].displacement.as_ref().unwrap().z, Some(-1.0));
+    }
+
+    /// A count no run reaches is an error, not a list of 4·10⁹ load factors (found by
+    /// the fuzzer: `count: 4294967295` asked for 32 GiB).
+    #[test]
+    fn an_impossible_increment_count_is_refused() {
+        let s = SolveSetup::parse("s", "materials: []\nincrements: {count: 4294967295}\n").unwrap();
+        let e = s.load_factors("s").unwrap_err().to_string();
+        assert!(e.contains("increments.count 4294967295 is more than 1000000"), "{e}");
+        let s = SolveSetup::parse("s", "materials: []\nincrements: {count: 1000000}\n").unwrap();
+        assert_eq!(s.load_factors("s").unwrap().len(), 1_000_000);
     }
 
     #[test]

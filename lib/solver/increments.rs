@@ -312,7 +312,7 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
                         }
                     }
                     results.increments.push(Increment {
-                        info: IncrementInfo { load_factor: lambda, cutbacks: cutbacks_this, iterations: conv.iterations, reactions, seconds_output: t.elapsed().as_secs_f64(), contact: summaries },
+                        info: IncrementInfo { load_factor: lambda, cutbacks: cutbacks_this, iterations: conv.iterations, reactions, seconds_output: super::clock::seconds_since(t), contact: summaries },
                         u: u.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
                         stress,
                         contact: states,

@@ -144,6 +144,9 @@ pub enum LinearSolverError {
     /// An external backend's failure, with its own words (PETSc names the function).
     #[error("{0}")]
     Backend(String),
+    /// The factorization would not fit in memory (checked after the symbolic analysis).
+    #[error("{0}")]
+    TooLarge(super::memory::TooLarge),
 }
 
 fn dof_text(dof: Option<usize>) -> String {
@@ -465,10 +468,10 @@ impl LinearSolver for FaerDirect {
                     None => SymmetricOrdering::Amd,
                     Some(p) => SymmetricOrdering::Custom(PermRef::new_checked(&p.forward, &p.inverse, n)),
                 };
-                Symbolic::Cholesky(
-                    factorize_symbolic_cholesky(owned.as_ref(), Side::Lower, ordering, Default::default())
-                        .map_err(|e| LinearSolverError::Faer(format!("{e:?}")))?,
-                )
+                let c = factorize_symbolic_cholesky(owned.as_ref(), Side::Lower, ordering, Default::default())
+                    .map_err(|e| LinearSolverError::Faer(format!("{e:?}")))?;
+                super::memory::check_cholesky(c.len_val(), n, owned.compute_nnz()).map_err(LinearSolverError::TooLarge)?;
+                Symbolic::Cholesky(c)
             }
             Symmetry::General => Symbolic::Lu(
                 factorize_symbolic_lu(owned.as_ref(), Default::default())

@@ -5,18 +5,20 @@
 //! the damping of bodies only contact holds ([`free_bodies`]), the static problem ([`problem`]) and its load curves ([`amplitude`]), Newton–Raphson for one increment ([`newton`]),
 //! the augmented Lagrangian's Uzawa loop ([`uzawa`]), the master-surface
 //! stabilisation ([`stabilization`]), load
-//! stepping with cutbacks ([`increments`]), restarting from a results file ([`restart`]), what the user sees ([`log`]), and a
+//! stepping with cutbacks ([`increments`]), restarting from a results file ([`restart`]), what the user sees ([`log`]), the wall-clock times it records ([`clock`]), and a
 //! timing benchmark on a clamped elastic cube ([`bench`]).
 
 pub mod amplitude;
 pub mod bench;
 pub mod block_rows;
+pub mod clock;
 pub mod forcing;
 pub mod free_bodies;
 pub mod gmres;
 pub mod increments;
 pub mod linear;
 pub mod log;
+pub mod memory;
 pub mod newton;
 pub mod ordering;
 #[cfg(feature = "petsc")]

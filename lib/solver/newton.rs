@@ -559,10 +559,10 @@ impl<'p> Newton<'p> {
             let r_norm = loop {
                 let t = Instant::now();
                 self.contact_search(u, iteration)?;
-                seconds_contact += t.elapsed().as_secs_f64();
+                seconds_contact += super::clock::seconds_since(t);
                 let t = Instant::now();
                 let assembled = self.assemble(u, lambda);
-                seconds_assembly += t.elapsed().as_secs_f64();
+                seconds_assembly += super::clock::seconds_since(t);
                 match assembled {
                     Ok(()) => {
                         dofs.gather_free(&self.residual, &mut self.rhs);
@@ -687,7 +687,7 @@ impl<'p> Newton<'p> {
             let t = Instant::now();
             self.linear.set_configuration(&self.problem.X, u);
             self.linear.factor(self.assembly.values()).map_err(|error| IncrementFailure::Linear { iteration, error })?;
-            row.seconds_factor = t.elapsed().as_secs_f64();
+            row.seconds_factor = super::clock::seconds_since(t);
             if let Some(forcing) = &mut self.forcing {
                 self.linear.set_forcing(forcing.next(residual));
             }
@@ -695,7 +695,7 @@ impl<'p> Newton<'p> {
             // K_ff Δu_f = −R_f; Δu is kept in r_free for the next energy norm.
             self.r_free.iter_mut().zip(&self.rhs).for_each(|(du, r)| *du = -r);
             self.linear.solve_in_place(&mut self.r_free).map_err(|error| IncrementFailure::Linear { iteration, error })?;
-            row.seconds_solve = t.elapsed().as_secs_f64();
+            row.seconds_solve = super::clock::seconds_since(t);
             let report = self.linear.last_solve();
             row.krylov_iterations = report.krylov_iterations as u32;
             if let Some(why) = report.fallback {

@@ -1,6 +1,7 @@
 mod bad_input;
 mod check;
 mod import_export;
+mod output_paths;
 mod paraview;
 mod pipeline;
 mod plot;

@@ -144,3 +144,40 @@ fn warnings_survive_quiet() {
     let o = run("sc-import", &["meshes/parisch.msh", "-o", "p.scmesh"], dir.path());
     assert!(stderr(&o).starts_with("read ") && stderr(&o).contains("sc-import: warning: "), "{}", stderr(&o));
 }
+
+/// Two pipelines writing into one output folder at once: the second refuses at its
+/// first write there, naming the first (its process and pipeline), and writes
+/// nothing; the first completes with whole files; once it has ended the folder is
+/// free again (its lock is gone) and the second runs.
+#[test]
+fn a_second_pipeline_into_the_same_folder_refuses() {
+    let dir = staged_pipeline("crossed_beams", &["crossed_beams.msh"]);
+    let yaml = dir.path().join("pipelines/crossed_beams.yaml");
+    // a load path of 150 increments keeps the first pipeline busy for seconds
+    let text = std::fs::read_to_string(&yaml).unwrap().replace("increments: {count: 3,", "increments: {count: 150,");
+    std::fs::write(&yaml, text).unwrap();
+    let lock = dir.path().join("pipelines/out").join(splinecontact::folder_lock::LOCK_NAME);
+    let mut first = std::process::Command::new(env!("CARGO_BIN_EXE_sc-pipeline"))
+        .args(["pipelines/crossed_beams.yaml", "-q"])
+        .current_dir(dir.path())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    while !lock.exists() {
+        assert!(start.elapsed().as_secs() < 30, "the first pipeline never locked its output folder");
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    let second = run("sc-pipeline", &["pipelines/crossed_beams.yaml", "-q"], dir.path());
+    let err = stderr(&second);
+    let still_running = first.try_wait().unwrap().is_none();
+    assert_eq!(second.status.code(), Some(1), "{err}");
+    assert!(err.contains(&format!("another sc-pipeline (process {}, running pipelines/crossed_beams.yaml)", first.id())), "{err}");
+    assert!(still_running, "the first pipeline ended before the second was refused: the test proves nothing");
+    assert!(first.wait().unwrap().success());
+    assert!(!lock.exists(), "the lock outlived its pipeline");
+    let r = splinecontact::format::scres::Results::read(&dir.path().join("pipelines/out/crossed_beams.scres")).unwrap();
+    assert_eq!((r.status, r.increments.len() >= 150, r.tail), (splinecontact::format::scres::RunStatus::Completed, true, None));
+    let again = run("sc-pipeline", &["pipelines/crossed_beams.yaml", "-q"], dir.path());
+    assert!(again.status.success(), "{}", stderr(&again));
+}

@@ -295,3 +295,30 @@ fn petsc_options_without_the_petsc_solver_are_reported_as_ignored() {
     assert!(o.status.success(), "{err}");
     assert!(err.contains("warning: PETSc options are given") && err.contains("they are ignored"), "{err}");
 }
+
+/// A model whose factorization does not fit in the memory there is stops before
+/// the factorization, with an estimate, writing nothing (the memory is `SC_MEMORY_LIMIT`
+/// here: a real machine too small for the test's model would need gigabytes).
+#[test]
+fn a_model_too_large_for_memory_fails_before_factorization_with_an_estimate() {
+    let dir = tempdir();
+    imported_cantilever(dir.path());
+    write_setup(dir.path(), GOOD);
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_sc-solve"))
+        .args(["c.scmesh", "--setup", "setup.yaml", "-o", "r.scres"])
+        .current_dir(dir.path())
+        .env("SC_MEMORY_LIMIT", "64K")
+        .output()
+        .unwrap();
+    assert_fails(&o, 2, &["too large for this machine's memory", "unknowns holds", "needs about", "64 KiB are available (SC_MEMORY_LIMIT)"], &dir.path().join("r.scres"));
+    let err = stderr(&o);
+    assert!(!err.contains("increment 1/"), "the solve started increments: {err}");
+    // with the memory there is, the same solve runs
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_sc-solve"))
+        .args(["c.scmesh", "--setup", "setup.yaml", "-o", "r.scres", "-q"])
+        .current_dir(dir.path())
+        .env("SC_MEMORY_LIMIT", "1G")
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+}

@@ -8,5 +8,7 @@ mod ironing;
 mod shallow_ironing;
 mod sliding;
 mod ccx_compare;
+mod crash;
+mod determinism;
 #[cfg(feature = "petsc")]
 mod petsc;
