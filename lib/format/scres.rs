@@ -158,6 +158,9 @@ pub struct Increment {
     pub contact: Vec<Vec<[f64; 6]>>,
     /// Per pair, per slave node: [`FRICTION_COLUMNS`]; empty for frictionless pairs.
     pub friction: Vec<Vec<[f64; 9]>>,
+    /// Per pair, per face of its slave face set (the set's order): the mean contact
+    /// pressure over the face (`post::contact_pressure`); empty for a node-set slave.
+    pub face_pressure: Vec<Vec<f64>>,
 }
 
 impl Increment {
@@ -267,6 +270,9 @@ impl Results {
                 let v: Vec<f64> = fr.iter().flatten().copied().collect();
                 w.f64s(&format!("inc/{k}/pair/{p}/friction"), &[fr.len() as u64, 9], &v);
             }
+            for (p, fp) in inc.face_pressure.iter().enumerate().filter(|(_, f)| !f.is_empty()) {
+                w.f64s(&format!("inc/{k}/pair/{p}/face_pressure"), &[fp.len() as u64], fp);
+            }
             w.end_segment();
         }
         if self.status != RunStatus::Running {
@@ -334,7 +340,21 @@ impl Results {
                 }
                 friction.push(v.chunks_exact(9).map(|c| std::array::from_fn(|i| c[i])).collect());
             }
-            increments.push(Increment { info, u: u.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(), stress, contact, friction });
+            let mut face_pressure = Vec::with_capacity(pairs.len());
+            for (p, pair) in pairs.iter().enumerate() {
+                let name = format!("inc/{k}/pair/{p}/face_pressure");
+                if f.array(&name).is_none() {
+                    face_pressure.push(Vec::new());
+                    continue;
+                }
+                let v = f.f64s(&name, None)?;
+                let faces = mesh.face_set(&pair.slave).map_or(0, |fs| fs.faces.len());
+                if v.len() != faces {
+                    return Err(f.invalid(&name, format!("expected one value per face of slave face set '{}' ({faces})", pair.slave)));
+                }
+                face_pressure.push(v.to_vec());
+            }
+            increments.push(Increment { info, u: u.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(), stress, contact, friction, face_pressure });
         }
         Ok(Self { mesh, source: meta.source, setup: meta.setup, status, increments, pairs, restart: meta.restart, tail: f.tail.clone() })
     }

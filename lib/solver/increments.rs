@@ -311,19 +311,21 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
                             log.line(&format!("increment {}/{n_inc}: contact holds body '{name}': its damping is off from the next increment", k + 1));
                         }
                     }
+                    let face_pressure = face_pressures(results, &states);
                     results.increments.push(Increment {
                         info: IncrementInfo { load_factor: lambda, cutbacks: cutbacks_this, iterations: conv.iterations, reactions, seconds_output: super::clock::seconds_since(t), contact: summaries },
                         u: u.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
                         stress,
                         contact: states,
                         friction,
+                        face_pressure,
                     });
                     write(&mut file, results, out, log)?;
                     if !out.writer {
                         // nor does it keep the history's arrays (0.2 GB an increment at
                         // 1M dofs); the count and the summaries stay
                         if let Some(old) = results.increments.len().checked_sub(2).and_then(|i| results.increments.get_mut(i)) {
-                            (old.u, old.contact, old.friction) = (Vec::new(), Vec::new(), Vec::new());
+                            (old.u, old.contact, old.friction, old.face_pressure) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
                         }
                     }
                     summary.increments += 1;
@@ -417,4 +419,22 @@ fn facet_hint(p: &Problem) -> String {
         " (pair '{}' has a facet master: if it is the softer body under a sliding slave, its quasi-static path can need a snap that Newton cannot follow; `stabilization: 0.15` in its contact entry or a B-spline master can help: docs/pipelines.md)",
         facets.join("', '")
     )
+}
+
+/// The mean contact pressure over every slave face of every pair whose slave is a
+/// face set (`post::contact_pressure`), from the slave nodes' −t_N of `states`.
+fn face_pressures(results: &Results, states: &[Vec<[f64; 6]>]) -> Vec<Vec<f64>> {
+    let mesh = &results.mesh;
+    results
+        .pairs
+        .iter()
+        .zip(states)
+        .map(|(pair, st)| {
+            let Some(fs) = mesh.face_set(&pair.slave).filter(|_| pair.slave_kind == crate::format::sccontact::SlaveKind::FaceSet) else {
+                return Vec::new();
+            };
+            let faces: Vec<[u32; 4]> = fs.faces.iter().map(|&f| mesh.face_nodes(f)).collect();
+            crate::post::contact_pressure::face_pressures(mesh, &faces, |n| pair.slave_nodes.binary_search(&n).ok().and_then(|s| st.get(s)).map_or(0.0, |row| -row[1]))
+        })
+        .collect()
 }

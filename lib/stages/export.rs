@@ -108,6 +108,7 @@ pub fn write_results_pvd(results: &Results, output: &Path) -> Result<String, Sta
         stress: vec![[[0.0; 9]; 8]; mesh.hexes.len()],
         contact: vec![],
         friction: vec![],
+        face_pressure: vec![],
     };
     // friction fields in every step when any increment carries them
     let frictional = results.increments.iter().any(|i| i.friction.iter().any(|f| !f.is_empty()));
