@@ -77,6 +77,15 @@ pub struct ContactPair {
 }
 
 impl ContactPair {
+    /// The faces of the slave face set (mesh node ids, cycle order), `None` for a
+    /// node-set slave.
+    pub fn slave_faces(&self, mesh: &crate::mesh::Mesh) -> Option<Vec<[u32; 4]>> {
+        if self.slave_kind != SlaveKind::FaceSet {
+            return None;
+        }
+        mesh.face_set(&self.slave).map(|fs| fs.faces.iter().map(|&f| mesh.face_nodes(f)).collect())
+    }
+
     /// The open uniform knot vectors (eq. 5.1) along ξ¹ and ξ²; fails when an order
     /// does not fit the net ("a 3-node row cannot carry order 4").
     pub fn knot_vectors(&self) -> Result<[KnotVector; 2], SplineError> {

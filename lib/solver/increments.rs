@@ -430,10 +430,9 @@ fn face_pressures(results: &Results, states: &[Vec<[f64; 6]>]) -> Vec<Vec<f64>> 
         .iter()
         .zip(states)
         .map(|(pair, st)| {
-            let Some(fs) = mesh.face_set(&pair.slave).filter(|_| pair.slave_kind == crate::format::sccontact::SlaveKind::FaceSet) else {
+            let Some(faces) = pair.slave_faces(mesh) else {
                 return Vec::new();
             };
-            let faces: Vec<[u32; 4]> = fs.faces.iter().map(|&f| mesh.face_nodes(f)).collect();
             crate::post::contact_pressure::face_pressures(mesh, &faces, |n| pair.slave_nodes.binary_search(&n).ok().and_then(|s| st.get(s)).map_or(0.0, |row| -row[1]))
         })
         .collect()

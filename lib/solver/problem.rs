@@ -202,10 +202,7 @@ fn contact_definitions(mesh: &Mesh, pairs: &[ContactPair], setup: &SolveSetup, f
                 return Err(bad(format!("adjust must be a length ≥ 0 (0: off), found {d}")));
             }
         }
-        let slave_faces: Vec<[u32; 4]> = match (pair.slave_kind, mesh.face_set(&pair.slave)) {
-            (SlaveKind::FaceSet, Some(fs)) => fs.faces.iter().map(|&f| mesh.face_nodes(f)).collect(),
-            _ => Vec::new(),
-        };
+        let slave_faces = pair.slave_faces(mesh).unwrap_or_default();
         if c.integration == Integration::Mortar {
             if slave_faces.is_empty() {
                 return Err(bad(format!("integration: mortar integrates over the slave faces, but slave '{}' is a node set; give the slave as a face set (sc-tag) or use integration: node", pair.slave)));

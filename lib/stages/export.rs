@@ -155,12 +155,14 @@ pub fn write_results_pvd(results: &Results, output: &Path) -> Result<String, Sta
     // the slave surfaces with the pressure per node and per face: one series per pair
     let mut slaves = Vec::new();
     for (p, pair) in results.pairs.iter().enumerate() {
-        let Some(faces) = slave_faces(mesh, pair) else { continue };
+        let Some(faces) = pair.slave_faces(mesh) else { continue };
         let mut series = Vec::new();
         for (k, inc) in std::iter::once(&zero).chain(results.increments.iter()).enumerate() {
             let name = format!("{stem}_{}_slave_{k}.vtu", pair.name);
             let pressure = |s: usize| inc.contact.get(p).and_then(|st| st.get(s)).map_or(0.0, |row| -row[1]);
-            slave_surface_grid(mesh, pair, &faces, &inc.u, pressure).write_vtu(&dir.join(&name))?;
+            // the face pressures the results file carries (files written before it: computed)
+            let stored = inc.face_pressure.get(p).filter(|v| v.len() == faces.len()).map(Vec::as_slice);
+            slave_surface_grid(mesh, pair, &faces, &inc.u, pressure, stored).write_vtu(&dir.join(&name))?;
             series.push((inc.info.load_factor, name));
         }
         let pvd = dir.join(format!("{stem}_{}_slave.pvd", pair.name));
@@ -172,19 +174,12 @@ pub fn write_results_pvd(results: &Results, output: &Path) -> Result<String, Sta
     Ok(format!("wrote {} ({} increments + the undeformed state){also}", output.display(), results.increments.len()))
 }
 
-/// The faces of a pair's slave face set (mesh node ids), `None` for a node-set slave.
-fn slave_faces(mesh: &crate::mesh::Mesh, pair: &ContactPair) -> Option<Vec<[u32; 4]>> {
-    if pair.slave_kind != crate::format::sccontact::SlaveKind::FaceSet {
-        return None;
-    }
-    mesh.face_set(&pair.slave).map(|fs| fs.faces.iter().map(|&f| mesh.face_nodes(f)).collect())
-}
-
 /// A pair's slave surface, deformed by `u`: its faces as quads over the slave nodes,
 /// point data `contact_pressure` (−t_N of each slave node, `pressure(s)` by slave
 /// index) and `gmsh_node_tag`, cell data `contact_pressure_face` (the mean of the
-/// interpolated pressure over the face, `post::contact_pressure`).
-pub fn slave_surface_grid(mesh: &crate::mesh::Mesh, pair: &ContactPair, faces: &[[u32; 4]], u: &[[f64; 3]], pressure: impl Fn(usize) -> f64) -> vtk::Grid {
+/// interpolated pressure over the face, `post::contact_pressure`; `face_pressure`
+/// when given, one per face of `faces`).
+pub fn slave_surface_grid(mesh: &crate::mesh::Mesh, pair: &ContactPair, faces: &[[u32; 4]], u: &[[f64; 3]], pressure: impl Fn(usize) -> f64, face_pressure: Option<&[f64]>) -> vtk::Grid {
     let nodes = &pair.slave_nodes;
     let points = nodes
         .iter()
@@ -203,7 +198,10 @@ pub fn slave_surface_grid(mesh: &crate::mesh::Mesh, pair: &ContactPair, faces: &
         }
     }
     let nodal: Vec<f64> = (0..nodes.len()).map(&pressure).collect();
-    let face = crate::post::contact_pressure::face_pressures(mesh, &kept, |n| local(n).map_or(0.0, |s| nodal[s]));
+    let face = match face_pressure {
+        Some(v) if kept.len() == faces.len() => v.to_vec(),
+        _ => crate::post::contact_pressure::face_pressures(mesh, &kept, |n| local(n).map_or(0.0, |s| nodal[s])),
+    };
     g.point_data.push(vtk::Field::scalar_f64("contact_pressure", nodal));
     g.point_data.push(vtk::Field { name: "gmsh_node_tag".into(), components: 1, values: vtk::FieldValues::I64(nodes.iter().map(|&n| mesh.node_tags[n as usize] as i64).collect()) });
     g.cell_data.push(vtk::Field::scalar_f64("contact_pressure_face", face));

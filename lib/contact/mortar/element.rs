@@ -322,7 +322,7 @@ mod tests {
                 }
                 assert!(st.active && st.g_n < 0.0, "order {order}: {st:?}");
                 let u: Vec<f64> = nodes.iter().flat_map(|&n| x_all[n as usize].iter().copied().collect::<Vec<_>>()).collect();
-                let mut mfd = mortar_clone(&mortar);
+                let mut mfd = mortar.clone();
                 let k_fd = fd_jacobian(
                     |v, out| {
                         let mut x = x_all.clone();
@@ -360,27 +360,6 @@ mod tests {
                     assert!(asym < 1e-10, "facet master: K symmetric (the Hessian of ĝ), found {asym:e}");
                 }
             }
-        }
-    }
-
-    fn mortar_clone(m: &Mortar) -> Mortar {
-        Mortar {
-            faces: m.faces.clone(),
-            faces_ref: m.faces_ref.clone(),
-            duals: m.duals.clone(),
-            faces_of: m.faces_of.clone(),
-            trace: m.trace.clone(),
-            na: m.na,
-            n_cells: m.n_cells,
-            points: m.points.clone(),
-            node_cell: m.node_cell.clone(),
-            gap: m.gap.clone(),
-            covered: m.covered.clone(),
-            nodes: m.nodes.clone(),
-            skipped_cells: m.skipped_cells,
-            transfer: m.transfer,
-            net: m.net.clone(),
-            slaves: m.slaves.clone(),
         }
     }
 }

@@ -67,6 +67,7 @@ pub struct MortarPoint {
 }
 
 /// The mortar integration of one pair.
+#[derive(Clone)]
 pub struct Mortar {
     /// Slave faces as indices into the pair's slave list, corners in cycle order.
     faces: Vec<[u32; 4]>,
@@ -231,6 +232,7 @@ impl Mortar {
             *c = p.converged.then_some(cell);
         });
         let (na, n_cells, node_cell) = (self.na, self.n_cells, &self.node_cell);
+        let square = SQUARE.map(|p| P2::new(p[0], p[1]));
         let skipped: usize = self
             .points
             .par_iter_mut()
@@ -248,7 +250,6 @@ impl Mortar {
                 let start = face.iter().map(|&s| &foot[s as usize]).find(|p| p.converged).map(|p| p.xi);
                 let lo = [0, 1].map(|al| cells.iter().map(|c| c[al]).min().unwrap_or(0).saturating_sub(1));
                 let hi = [0, 1].map(|al| (cells.iter().map(|c| c[al]).max().unwrap_or(0) + 1).min(n_cells[al] - 1));
-                let square: Vec<P2> = SQUARE.iter().map(|p| P2::new(p[0], p[1])).collect();
                 let (mut seg, mut scratch) = (Vec::with_capacity(8), Vec::with_capacity(8));
                 let mut skipped = 0;
                 for j in lo[1]..=hi[1] {
@@ -257,15 +258,15 @@ impl Mortar {
                         let corners = [k00, k00 + 1, k00 + 1 + na, k00 + na];
                         let (lo, hi) = trace.facets().cell_bounds([i, j]);
                         let corner_xi = [[lo[0], lo[1]], [hi[0], lo[1]], [hi[0], hi[1]], [lo[0], hi[1]]];
-                        let mut quad = Vec::with_capacity(4);
-                        for (&k, &cxi) in corners.iter().zip(&corner_xi) {
+                        let mut quad = [P2::zeros(); 4];
+                        let mut met = 0;
+                        for (q, (&k, &cxi)) in quad.iter_mut().zip(corners.iter().zip(&corner_xi)) {
                             let n = trace.evaluate_in_cell(cxi, [i, j]).n_bar;
-                            match ray_bilinear(&xf, &x_net[k], &n) {
-                                Some(e) => quad.push(P2::new(e[0], e[1])),
-                                None => break,
-                            }
+                            let Some(e) = ray_bilinear(&xf, &x_net[k], &n) else { break };
+                            *q = P2::new(e[0], e[1]);
+                            met += 1;
                         }
-                        if quad.len() < 4 {
+                        if met < 4 {
                             continue;
                         }
                         let a2 = signed_area2(&quad);
