@@ -23,4 +23,4 @@ pub mod net;
 pub mod pair;
 pub mod tributary;
 
-pub use net::{control_net, ControlNet, NetError};
+pub use net::{control_net, master_net, ControlNet, MasterNet, NetChoice, NetError, NetShape, PatchNet};
