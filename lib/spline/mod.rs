@@ -12,6 +12,7 @@
 //! | [`facet`]       | the same control net read as bilinear 4-node facets (for comparison) |
 //! | [`span_tree`]   | AABB hierarchy over knot spans / facet cells, refittable |
 //! | [`projection`]  | closest-point projection, eq. 2.2 (global search + box-constrained Newton) |
+//! | [`atlas`]       | a master of many charts: periodic and multi-patch B-splines, facets on any quad surface |
 //!
 //! ## Notation (paper symbol ↔ Rust name ↔ equation)
 //! | paper | Rust | eq. |
@@ -32,6 +33,7 @@
 //! Control points are stored `i + na * j` with `i` along direction 1 (ξ¹) and `j`
 //! along direction 2 (ξ²). The parameter domain is `[0, 1]²`.
 
+pub mod atlas;
 pub mod basis;
 pub mod facet;
 pub mod knots;
@@ -42,6 +44,7 @@ pub mod span_tree;
 #[cfg(test)]
 mod fd;
 
+pub use atlas::{Atlas, AtlasProjector, EdgeKind};
 pub use facet::{FacetProjector, FacetSurface};
 pub use knots::KnotVector;
 pub use patch::{BSplinePatch, SurfaceBasis, SurfacePoint};
