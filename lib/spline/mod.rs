@@ -74,4 +74,6 @@ pub enum SplineError {
     ControlNetSize { got: usize, na: usize, nb: usize, expected: usize },
     #[error("control point {index} is not finite: {point:?}")]
     NonFiniteControlPoint { index: usize, point: [f64; 3] },
+    #[error("{what} is not available in this build")]
+    Unsupported { what: String },
 }
