@@ -12,6 +12,7 @@
 //! | [`facet`]       | the same control net read as bilinear 4-node facets (for comparison) |
 //! | [`span_tree`]   | AABB hierarchy over knot spans / facet cells, refittable |
 //! | [`projection`]  | closest-point projection, eq. 2.2 (global search + box-constrained Newton) |
+//! | [`subdivision`] | Catmull–Clark limit surface of any manifold quad control mesh (exact evaluation, basis) |
 //!
 //! ## Notation (paper symbol ↔ Rust name ↔ equation)
 //! | paper | Rust | eq. |
@@ -38,6 +39,7 @@ pub mod knots;
 pub mod patch;
 pub mod projection;
 pub mod span_tree;
+pub mod subdivision;
 
 #[cfg(test)]
 mod fd;
