@@ -265,6 +265,7 @@ impl CatmullClark {
 
     /// Basis weights over the support of `face` at `xi` for derivative rows
     /// `0..n_rows`, derivatives with respect to the face's `(u, v)`. Returns the support.
+    #[allow(clippy::needless_range_loop)] // k (stencil point), r (derivative row), col (node) are math indices
     fn weights_into(&self, face: usize, xi: [f64; 2], n_rows: usize, w: &mut Rows) -> &[u32] {
         let fd = &self.faces[face];
         let [u, v] = xi.map(|x| x.clamp(0.0, 1.0));
