@@ -32,7 +32,16 @@
 //! moves out along the diagonal to max(s, t) = 2^{−L}: the position is then the limit
 //! point to within `1e-16` of the stencil size and every derivative is finite, but the
 //! metric degenerates as the theory says: first derivatives scale like `(2λ)^L`
-//! (→ 0 for N = 3, large for N ≥ 5), second like `(4λ)^L`.
+//! (→ 0 for N = 3, large for N ≥ 5), second like `(4λ)^L`. The normal there is the
+//! limit normal to `(μ/λ)^L` (μ the next eigenvalue): 1e-11 up to N = 6, 1e-3 at N = 14.
+//!
+//! **Cost.** Regular faces: one bicubic evaluation. Near a vertex, one `(2N+8)²`
+//! vector–matrix product per level `k = ⌊−log2 max(s, t)⌋` (≈ 10 at 1e-3, `L(N)` at the
+//! vertex). No allocation in [`CatmullClark::evaluate_into`] or [`CatmullClark::jet`].
+//!
+//! **For a search tree.** The basis is non-negative (tested on every mesh here, phantoms
+//! folded in), so face `f` lies in the convex hull of [`CatmullClark::face_support`].
+//! Parameters outside `[0,1]²` are clamped to the face.
 #![allow(non_snake_case)]
 
 mod bicubic;

@@ -228,6 +228,10 @@ fn check_partition_of_unity(cc: &CatmullClark, x: &[Vec3], face: usize, xi: [f64
         }
     }
     assert!(sp.n_bar.iter().all(|c| c.is_finite()), "n̄ finite {tag}");
+    // Q ≥ 0 (phantoms folded in): the face lies in the convex hull of its support, so
+    // the support's bounding box bounds the face for a search tree
+    let q_min = b.q().iter().copied().fold(f64::INFINITY, f64::min);
+    assert!(q_min >= -1e-15, "Q_min = {q_min:e} {tag}");
     sp
 }
 
@@ -554,6 +558,41 @@ fn basis_is_a_partition_of_unity_and_planes_stay_planes() {
             assert!((sp.a_alpha[0] - Vec3::x()).norm() < 1e-13 && (sp.a_alpha[1] - Vec3::y()).norm() < 1e-13);
         }
     }
+}
+
+/// The boundary rule: along the open edge j = 0 of a grid the limit curve is the
+/// uniform cubic B-spline of the boundary nodes with the end phantoms `2P_0 − P_1`,
+/// so it passes through the convex corners; the cross-boundary second derivative
+/// `P_{−1} − 2P_0 + P_1` of the bicubic vanishes with the phantom row.
+#[test]
+fn boundary_curve_is_the_cubic_bspline_of_the_boundary_nodes() {
+    let (nx, ny) = (6, 4);
+    let mesh = grid_mesh(nx, ny);
+    let x = wavy_grid(nx, ny);
+    let cc = CatmullClark::new(&mesh).unwrap();
+    // boundary polygon with its two phantoms
+    let mut poly = vec![x[0] * 2.0 - x[1]];
+    poly.extend_from_slice(&x[..nx]);
+    poly.push(x[nx - 1] * 2.0 - x[nx - 2]);
+    let mut worst = 0.0f64;
+    for i in 0..nx - 1 {
+        for u in [0.0, 0.2, 0.5, 0.77, 1.0] {
+            let b = bicubic::cubic(u);
+            let curve: Vec3 = (0..4).map(|k| poly[i + k] * b[0][k]).sum();
+            let tangent: Vec3 = (0..4).map(|k| poly[i + k] * b[1][k]).sum();
+            let sp = cc.evaluate(&x, i, [u, 0.0]);
+            worst = worst.max((sp.x_bar - curve).norm()).max((sp.a_alpha[0] - tangent).norm());
+            assert!((sp.x_bar - curve).norm() < 1e-14, "face {i} u {u}: {:?} vs {curve:?}", sp.x_bar);
+            assert!((sp.a_alpha[0] - tangent).norm() < 1e-13, "face {i} u {u}: tangent");
+            assert!(sp.a_alpha_beta[1][1].norm() < 1e-13, "face {i} u {u}: x̄_,vv = {:?}", sp.a_alpha_beta[1][1]);
+        }
+    }
+    // convex corners are interpolated
+    let last = nx * ny - 1;
+    for (face, xi, node) in [(0, [0.0, 0.0], 0), (nx - 2, [1.0, 0.0], nx - 1), (cc.n_faces() - 1, [1.0, 1.0], last)] {
+        assert!((cc.evaluate(&x, face, xi).x_bar - x[node]).norm() < 1e-14, "corner node {node}");
+    }
+    println!("grid boundary curve vs cubic B-spline of the boundary nodes: {worst:.1e}");
 }
 
 // ---------------------------------------------------------------- 4. limit mask
