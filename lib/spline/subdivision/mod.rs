@@ -56,7 +56,7 @@ pub use catmull_clark::subdominant_eigenvalue;
 
 use bicubic::{row_of, Rows, N_ROWS, N_ROWS_JET, ORDERS};
 use catmull_clark::{subdivide, ValenceTables};
-use stencil::{grid_index, local_mesh, LocalMesh};
+use stencil::{grid_index, local_mesh, LocalMesh, OpenRing};
 use topology::Topology;
 
 use super::patch::Jet;
@@ -97,6 +97,15 @@ pub enum SubdivisionError {
     ValenceTooHigh { node: u32, valence: usize, max: usize },
     #[error("face {face} depends on {nodes} nodes, more than the {max} a basis can hold")]
     SupportTooLarge { face: usize, nodes: usize, max: usize },
+    #[error(
+        "the faces around the corners of face {face} do not form a Catmull–Clark stencil \
+         (a mesh too small or folded onto itself there)"
+    )]
+    StencilIncomplete { face: usize },
+    #[error("{got} control points for a mesh of {expected} nodes")]
+    ControlPointCount { got: usize, expected: usize },
+    #[error("control point {index} is not finite: {point:?}")]
+    NonFiniteControlPoint { index: usize, point: [f64; 3] },
 }
 
 /// How a face is evaluated (cost grows down the list).
@@ -128,6 +137,8 @@ struct FaceData {
     support: (usize, usize),
     pieces: (usize, usize),
     kind: FaceKind,
+    /// Per edge `c` (corner c → c+1): the face across it and that face's edge index.
+    across: [Option<(usize, usize)>; 4],
 }
 
 /// The Catmull–Clark limit surface of a [`QuadControlMesh`], ready to evaluate.
@@ -184,21 +195,25 @@ impl CatmullClark {
             let s0 = cc.support.len();
             cc.support.extend(&support);
             let p0 = cc.pieces.len();
-            let valence = |lm: &LocalMesh, g: usize, c: usize| lm.valence(g, c).expect("the local mesh holds every ring");
-            let ev: Vec<usize> = (0..4).filter(|&c| valence(&local, 0, c) != 4).collect();
+            let incomplete = |_| SubdivisionError::StencilIncomplete { face: f };
+            let mut valences = [0; 4];
+            for (c, n) in valences.iter_mut().enumerate() {
+                *n = local.valence(0, c).map_err(incomplete)?;
+            }
+            let ev: Vec<usize> = (0..4).filter(|&c| valences[c] != 4).collect();
             let kind = match ev.as_slice() {
                 [] => {
-                    cc.push_piece(&local, 0, 0, CORNERS);
+                    cc.push_piece(&local, 0, 0, CORNERS).map_err(incomplete)?;
                     FaceKind::Regular
                 }
                 &[r] => {
-                    cc.push_piece(&local, 0, r, CORNERS);
-                    FaceKind::Extraordinary { valence: valence(&local, 0, r) }
+                    cc.push_piece(&local, 0, r, CORNERS).map_err(incomplete)?;
+                    FaceKind::Extraordinary { valence: valences[r] }
                 }
                 _ => {
                     let (fine, children) = subdivide(&local);
                     for (c, child) in children[0].iter().enumerate() {
-                        let child = child.expect("the local mesh holds every ring");
+                        let child = child.ok_or(SubdivisionError::StencilIncomplete { face: f })?;
                         let mid = |a: [f64; 2], b: [f64; 2]| [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0];
                         let pos = [
                             CORNERS[c],
@@ -206,7 +221,7 @@ impl CatmullClark {
                             [0.5, 0.5],
                             mid(CORNERS[(c + 3) % 4], CORNERS[c]),
                         ];
-                        cc.push_piece(&fine, child, 0, pos);
+                        cc.push_piece(&fine, child, 0, pos).map_err(incomplete)?;
                     }
                     FaceKind::Split
                 }
@@ -218,16 +233,18 @@ impl CatmullClark {
                     }
                 }
             }
-            cc.faces.push(FaceData { support: (s0, support.len()), pieces: (p0, cc.pieces.len() - p0), kind });
+            let q = mesh.faces[f];
+            let across = [0, 1, 2, 3].map(|c| topo.half_edge(q[(c + 1) % 4], q[c]));
+            cc.faces.push(FaceData { support: (s0, support.len()), pieces: (p0, cc.pieces.len() - p0), kind, across });
         }
         Ok(cc)
     }
 
     /// Adds the piece of local face `g` with its origin at corner `r` (the
     /// extraordinary corner, if any); `pos` are the face parameters of `g`'s corners.
-    fn push_piece(&mut self, lm: &LocalMesh, g: usize, r: usize, pos: [[f64; 2]; 4]) {
-        let n = lm.valence(g, r).expect("the local mesh holds every ring");
-        let st = lm.stencil(g, r).expect("the local mesh holds every ring");
+    fn push_piece(&mut self, lm: &LocalMesh, g: usize, r: usize, pos: [[f64; 2]; 4]) -> Result<(), OpenRing> {
+        let n = lm.valence(g, r)?;
+        let st = lm.stencil(g, r)?;
         let origin = pos[r];
         let axis = |k: usize| [pos[k][0] - origin[0], pos[k][1] - origin[1]];
         let (es, et) = (axis((r + 1) % 4), axis((r + 3) % 4));
@@ -248,6 +265,7 @@ impl CatmullClark {
             self.row_ptr.push(self.entries.len() as u32);
         }
         self.pieces.push(Piece { origin, jac, valence: (n != 4).then_some(n), first_row });
+        Ok(())
     }
 
     /// Number of faces.
@@ -265,6 +283,14 @@ impl CatmullClark {
     pub fn face_support(&self, face: usize) -> &[u32] {
         let (s0, len) = self.faces[face].support;
         &self.support[s0..s0 + len]
+    }
+
+    /// The face across edge `edge` of `face` (edge c runs from corner c to c+1; corners
+    /// at ξ = (0,0), (1,0), (1,1), (0,1)) and its own index for that edge, or `None` on
+    /// an open boundary. The shared edge runs the other way there: the point at
+    /// fraction `τ` along edge c of `face` is at `1 − τ` along the returned edge.
+    pub fn neighbour_across(&self, face: usize, edge: usize) -> Option<(usize, usize)> {
+        self.faces[face].across[edge]
     }
 
     /// How face `face` is evaluated.
@@ -333,6 +359,17 @@ impl CatmullClark {
             }
         }
         self.face_support(face)
+    }
+
+    /// Checks that `x` holds a finite position for every node.
+    pub fn check_control_points(&self, x: &[Vec3]) -> Result<(), SubdivisionError> {
+        if x.len() < self.n_nodes {
+            return Err(SubdivisionError::ControlPointCount { got: x.len(), expected: self.n_nodes });
+        }
+        if let Some((index, p)) = x[..self.n_nodes].iter().enumerate().find(|(_, p)| !p.iter().all(|c| c.is_finite())) {
+            return Err(SubdivisionError::NonFiniteControlPoint { index, point: [p.x, p.y, p.z] });
+        }
+        Ok(())
     }
 
     #[track_caller]

@@ -176,10 +176,12 @@ pub(super) fn local_mesh(
                 keys.len() - 1
             });
         }
-        let mut sorted = idx;
-        sorted.sort_unstable();
-        if !seen_faces.contains(&sorted) {
-            seen_faces.push(sorted);
+        // the same face reached from two corners has the same node cycle
+        let first = (0..4).min_by_key(|&c| idx[c]).unwrap_or(0);
+        let mut cycle = idx;
+        cycle.rotate_left(first);
+        if !seen_faces.contains(&cycle) {
+            seen_faces.push(cycle);
             faces.push(idx);
         }
     };

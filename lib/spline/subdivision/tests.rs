@@ -667,7 +667,9 @@ fn check_continuity(mesh: &QuadControlMesh, x: &[Vec3], tag: &str) -> (f64, f64)
     let size = max_norm(x.iter());
     for (f, q) in mesh.faces.iter().enumerate() {
         for c in 0..4 {
-            let Some(&(g, d)) = half.get(&(q[(c + 1) % 4], q[c])) else { continue };
+            let twin = half.get(&(q[(c + 1) % 4], q[c])).copied();
+            assert_eq!(cc.neighbour_across(f, c), twin, "{tag}: neighbour of face {f} across edge {c}");
+            let Some((g, d)) = twin else { continue };
             for t in [0.1, 0.37, 0.5, 0.8] {
                 let on = |c: usize, t: f64| near_corner(c, t, 0.0);
                 let sf = cc.evaluate(x, f, on(c, t));
@@ -767,6 +769,42 @@ fn invalid_meshes_give_named_errors() {
     assert!(matches!(err(vec![[0, 1, 2, 3], [3, 2, 1, 0]], 4), SubdivisionError::ValenceTooLow { valence: 2, .. }));
     let (m15, _) = star_mesh(15, 1, 0.0);
     assert_eq!(CatmullClark::new(&m15).unwrap_err(), SubdivisionError::ValenceTooHigh { node: 0, valence: 15, max: 14 });
-    let (m14, _) = star_mesh(14, 1, 0.0);
-    assert!(CatmullClark::new(&m14).is_ok());
+    let (m14, mut x14) = star_mesh(14, 1, 0.0);
+    let cc = CatmullClark::new(&m14).unwrap();
+    assert!(cc.check_control_points(&x14).is_ok());
+    assert_eq!(
+        cc.check_control_points(&x14[1..]),
+        Err(SubdivisionError::ControlPointCount { got: x14.len() - 1, expected: x14.len() })
+    );
+    x14[3].y = f64::NAN;
+    assert!(matches!(cc.check_control_points(&x14), Err(SubdivisionError::NonFiniteControlPoint { index: 3, .. })));
+}
+
+/// An `n × m` torus (all valence 4): the smallest ones fold a face's stencil onto
+/// itself (grid points coincide), which the support absorbs (each node once in the
+/// basis, duplicates summed); the surface is the periodic bicubic B-spline.
+#[test]
+fn small_tori_are_periodic_bicubic_splines() {
+    for (n, m) in [(3, 3), (4, 3), (5, 6)] {
+        let id = |i: usize, j: usize| ((i % n) + n * (j % m)) as u32;
+        let mut faces = Vec::new();
+        let mut x = Vec::new();
+        for j in 0..m {
+            for i in 0..n {
+                faces.push([id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
+                let (a, b) = (2.0 * std::f64::consts::PI * i as f64 / n as f64, 2.0 * std::f64::consts::PI * j as f64 / m as f64);
+                x.push(Vec3::new((3.0 + b.cos()) * a.cos(), (3.0 + b.cos()) * a.sin(), b.sin()));
+            }
+        }
+        let mesh = QuadControlMesh { n_nodes: n * m, faces };
+        let cc = CatmullClark::new(&mesh).unwrap();
+        for face in 0..cc.n_faces() {
+            assert_eq!(cc.face_kind(face), FaceKind::Regular);
+            assert_eq!(cc.face_support(face).len(), n.min(4) * m.min(4));
+            for xi in interior_params() {
+                check_partition_of_unity(&cc, &x, face, xi, &format!("torus {n}×{m} face {face}"));
+            }
+        }
+        check_continuity(&mesh, &x, &format!("torus {n}×{m}"));
+    }
 }
