@@ -4,10 +4,10 @@
 //!
 //! | file               | concept |
 //! |--------------------|---------|
-//! | [`topology`]       | edges → faces, node rings, manifold and orientation checks |
-//! | [`stencil`]        | a face's local mesh with boundary phantoms, stencil order |
-//! | [`bicubic`]        | the uniform bicubic B-spline patch of a regular face |
-//! | [`catmull_clark`]  | the rules (S1–S3), the subdivision matrix, exact evaluation (E1) |
+//! | `topology.rs`       | edges → faces, node rings, manifold and orientation checks |
+//! | `stencil.rs`        | a face's local mesh with boundary phantoms, stencil order |
+//! | `bicubic.rs`        | the uniform bicubic B-spline patch of a regular face |
+//! | `catmull_clark.rs`  | the rules (S1–S3), the subdivision matrix, exact evaluation (E1) |
 //!
 //! **Faces and parameters.** Face `f` is `mesh.faces[f] = [n_0, n_1, n_2, n_3]`, its
 //! outward normal by the right-hand rule; `ξ = (u, v) ∈ [0,1]²` with `u` along
@@ -42,7 +42,6 @@
 //! **For a search tree.** The basis is non-negative (tested on every mesh here, phantoms
 //! folded in), so face `f` lies in the convex hull of [`CatmullClark::face_support`].
 //! Parameters outside `[0,1]²` are clamped to the face.
-#![allow(non_snake_case)]
 
 mod bicubic;
 mod catmull_clark;
