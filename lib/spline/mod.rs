@@ -12,7 +12,8 @@
 //! | [`facet`]       | the same control net read as bilinear 4-node facets (for comparison) |
 //! | [`span_tree`]   | AABB hierarchy over knot spans / facet cells, refittable |
 //! | [`projection`]  | closest-point projection, eq. 2.2 (global search + box-constrained Newton) |
-//! | [`atlas`]       | a master of many charts: periodic and multi-patch B-splines, facets on any quad surface |
+//! | [`subdivision`] | Catmull–Clark limit surface of any manifold quad control mesh (exact evaluation, basis) |
+//! | [`atlas`]       | a master of many charts: periodic and multi-patch B-splines, subdivision faces, facets on any quad surface |
 //!
 //! ## Notation (paper symbol ↔ Rust name ↔ equation)
 //! | paper | Rust | eq. |
@@ -40,6 +41,7 @@ pub mod knots;
 pub mod patch;
 pub mod projection;
 pub mod span_tree;
+pub mod subdivision;
 
 #[cfg(test)]
 mod fd;
