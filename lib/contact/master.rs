@@ -28,7 +28,7 @@ impl Projector {
         Ok(match (kind, &net.shape) {
             (MasterKind::Facet, NetShape::Grid { a, b }) => Self::Facet(FacetProjector::new(FacetSurface::new(*a, *b)?, x_net)?),
             (MasterKind::Facet, _) => Self::Atlas(AtlasProjector::new(Atlas::facets(n, net.cells()), x_net)?),
-            (MasterKind::Subdivision, _) => return Err(SplineError::Unsupported { what: "the subdivision (Catmull–Clark) master".into() }),
+            (MasterKind::Subdivision, _) => Self::Atlas(AtlasProjector::new(Atlas::subdivision(n, net.cells()).map_err(|e| SplineError::Subdivision { message: e.to_string() })?, x_net)?),
             (_, NetShape::Grid { a, b }) => Self::BSpline(BSplineProjector::new(BSplinePatch::new(*a, *b, orders[0], orders[1])?, x_net)?),
             (_, NetShape::Periodic { a, b }) => {
                 let nodes: Vec<u32> = (0..n as u32).collect();

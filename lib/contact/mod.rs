@@ -14,6 +14,8 @@
 //! | [`adjust`]    | slave nodes moved onto the master before the first increment (stress-free) |
 
 pub mod adjust;
+#[cfg(test)]
+mod atlas_fd;
 pub mod dual;
 pub mod element;
 pub mod friction;

@@ -78,4 +78,6 @@ pub enum SplineError {
     NonFiniteControlPoint { index: usize, point: [f64; 3] },
     #[error("{what} is not available in this build")]
     Unsupported { what: String },
+    #[error("Catmull–Clark master: {message}")]
+    Subdivision { message: String },
 }

@@ -9,6 +9,7 @@
 //! |--------|--------------|--------------------|
 //! | [`Atlas::facets`] | one quad, bilinear | C⁰ (a crease) |
 //! | [`Atlas::splines`] | one knot span of a B-spline patch (open or periodic knots) | C^{k−2} inside a patch, C⁰ at a seam between patches |
+//! | [`Atlas::subdivision`] | one quad of the Catmull–Clark limit surface ([`crate::spline::subdivision`]) | C² where regular, C¹ at extraordinary nodes |
 //!
 //! On a B-spline chart the patch parameter is `ξ = lo + h ⊙ (u, v)` over the span
 //! `[lo, lo + h]`, so `ā_α = h_α x̄_{,ξ^α}`, `ā_{α,β} = h_α h_β x̄_{,ξ^α ξ^β}` and the
@@ -24,6 +25,7 @@ pub mod tree;
 pub use projector::AtlasProjector;
 
 use super::patch::Jet;
+use super::subdivision::{CatmullClark, QuadControlMesh, SubdivisionError};
 use super::{BSplinePatch, KnotVector, SplineError, SurfacePoint, Vec3};
 
 /// What lies across one edge of a chart.
@@ -58,6 +60,7 @@ struct Sheet {
 enum Charts {
     Facets(Vec<[u32; 4]>),
     Splines(Vec<Sheet>),
+    Subdivision(CatmullClark),
 }
 
 /// The charts of a master surface and the current master node positions.
@@ -188,6 +191,66 @@ impl Atlas {
         Ok(Self { n_nodes, charts: Charts::Splines(sheets), n_charts, edges, offsets, support, x: vec![Vec3::zeros(); n_nodes] })
     }
 
+    /// The Catmull–Clark limit surface of `faces` (master node positions, outward
+    /// cycles): one chart per face; interior edges are smooth.
+    pub fn subdivision(n_nodes: usize, faces: Vec<[u32; 4]>) -> Result<Self, SubdivisionError> {
+        let cc = CatmullClark::new(&QuadControlMesh { n_nodes, faces })?;
+        let nf = cc.n_faces();
+        let edges = (0..nf)
+            .map(|f| {
+                // helper edges c run corner c → c+1 with corners (0,0) (1,0) (1,1) (0,1):
+                // edge 3 is u = 0, edge 1 is u = 1, edge 0 is v = 0, edge 2 is v = 1
+                let k = |c: usize| if cc.neighbour_across(f, c).is_some() { EdgeKind::Smooth } else { EdgeKind::Boundary };
+                [k(3), k(1), k(0), k(2)]
+            })
+            .collect();
+        let mut offsets = vec![0];
+        let mut support = Vec::new();
+        for f in 0..nf {
+            support.extend_from_slice(cc.face_support(f));
+            offsets.push(support.len());
+        }
+        Ok(Self { n_nodes, n_charts: nf, charts: Charts::Subdivision(cc), edges, offsets, support, x: vec![Vec3::zeros(); n_nodes] })
+    }
+
+    /// On a subdivision atlas, (u, v) of chart `from` (within one chart width beyond
+    /// one of its edges) on the chart `to` across that edge: the two faces' parameters
+    /// join along the shared edge, which runs the other way on `to`.
+    pub fn adjacent_parameter(&self, from: usize, uv: [f64; 2], to: usize) -> Option<[f64; 2]> {
+        let Charts::Subdivision(cc) = &self.charts else { return None };
+        // (fraction τ along edge c, depth inward) → (u, v), and back
+        let at = |c: usize, tau: f64, depth: f64| match c {
+            0 => [tau, depth],
+            1 => [1.0 - depth, tau],
+            2 => [1.0 - tau, 1.0 - depth],
+            _ => [depth, 1.0 - tau],
+        };
+        let [u, v] = uv;
+        let (c, tau, depth) = if v < 0.0 && (0.0..=1.0).contains(&u) {
+            (0, u, v)
+        } else if u > 1.0 && (0.0..=1.0).contains(&v) {
+            (1, v, 1.0 - u)
+        } else if v > 1.0 && (0.0..=1.0).contains(&u) {
+            (2, 1.0 - u, 1.0 - v)
+        } else if u < 0.0 && (0.0..=1.0).contains(&v) {
+            (3, 1.0 - v, u)
+        } else {
+            // inside `from` (or beyond a corner): the nearest edge shared with `to`
+            let cands = [(0, u, v), (1, v, 1.0 - u), (2, 1.0 - u, 1.0 - v), (3, 1.0 - v, u)];
+            let (c, tau, depth) = cands.into_iter().filter(|&(c, _, _)| cc.neighbour_across(from, c).is_some_and(|(f, _)| f == to)).min_by(|a, b| a.2.total_cmp(&b.2))?;
+            let (f2, c2) = cc.neighbour_across(from, c)?;
+            return (f2 == to).then(|| at(c2, 1.0 - tau.clamp(0.0, 1.0), -depth));
+        };
+        let (f2, c2) = cc.neighbour_across(from, c)?;
+        (f2 == to).then(|| at(c2, 1.0 - tau, -depth))
+    }
+
+    /// Whether the charts are Catmull–Clark faces (their polynomials do not continue
+    /// beyond the face: parameters are clamped to it).
+    pub fn is_subdivision(&self) -> bool {
+        matches!(self.charts, Charts::Subdivision(_))
+    }
+
     pub fn n_nodes(&self) -> usize {
         self.n_nodes
     }
@@ -255,6 +318,7 @@ impl Atlas {
                 let twist = x0 - x1 + x2 - x3;
                 Jet { x: p, a: [a1, a2], aa: [[Vec3::zeros(), twist], [twist, Vec3::zeros()]] }
             }
+            Charts::Subdivision(cc) => cc.jet(&self.x, chart, uv),
             Charts::Splines(sheets) => {
                 let (sh, span, lo, h) = Self::span_of(sheets, chart);
                 let j = sh.patch.jet_in_span(&sh.x, [lo[0] + h[0] * uv[0], lo[1] + h[1] * uv[1]], span);
@@ -300,6 +364,7 @@ impl Atlas {
                 }
                 out.basis.remap_scale(|k| sh.map[k] as usize, h);
             }
+            Charts::Subdivision(cc) => cc.evaluate_into(&self.x, chart, uv, out),
         }
         out.clamped = [false; 2];
         out.complete_metric();
@@ -315,7 +380,7 @@ impl Atlas {
     /// for facets. Lets the friction history move between spans exactly.
     pub fn patch_parameter(&self, chart: usize, uv: [f64; 2]) -> Option<(usize, [f64; 2])> {
         match &self.charts {
-            Charts::Facets(_) => None,
+            Charts::Facets(_) | Charts::Subdivision(_) => None,
             Charts::Splines(sheets) => {
                 let p = sheets.partition_point(|s| s.first_chart <= chart) - 1;
                 let (_, _, lo, h) = Self::span_of(sheets, chart);
@@ -328,7 +393,7 @@ impl Atlas {
     /// periodic direction wrapped to the image nearest the chart.
     pub fn chart_parameter(&self, chart: usize, xi: [f64; 2]) -> [f64; 2] {
         match &self.charts {
-            Charts::Facets(_) => xi,
+            Charts::Facets(_) | Charts::Subdivision(_) => xi,
             Charts::Splines(sheets) => {
                 let (sh, _, lo, h) = Self::span_of(sheets, chart);
                 let mut u = [(xi[0] - lo[0]) / h[0], (xi[1] - lo[1]) / h[1]];

@@ -35,7 +35,10 @@ const UNIT: ([f64; 2], [f64; 2]) = ([0.0; 2], [1.0; 2]);
 impl AtlasProjector {
     pub fn new(mut atlas: Atlas, x: &[Vec3]) -> Result<Self, SplineError> {
         atlas.update(x)?;
-        let tree = ChartTree::new(atlas.n_charts(), &|c| atlas.support(c), x, 0.0);
+        // the limit surface lies in its stencil's hull (non-negative basis); a margin
+        // of a tenth of a box guards the phantom-folded boundary faces
+        let inflate = if atlas.is_subdivision() { 0.1 } else { 0.0 };
+        let tree = ChartTree::new(atlas.n_charts(), &|c| atlas.support(c), x, inflate);
         let scale = tree.diagonal();
         Ok(Self { atlas, tree, scale, options: ProjectionOptions::default() })
     }
@@ -147,6 +150,8 @@ impl AtlasProjector {
     pub fn project_extended(&self, p: &Vec3, chart: usize, margin: [f64; 2]) -> Projection {
         let mut lo = [0.0; 2];
         let mut hi = [1.0; 2];
+        // a Catmull–Clark face does not continue beyond its edges
+        let margin = if self.atlas.is_subdivision() { [0.0; 2] } else { margin };
         for al in 0..2 {
             if self.atlas.edge(chart, 2 * al) == EdgeKind::Boundary {
                 lo[al] -= margin[al];
@@ -207,7 +212,11 @@ impl AtlasProjector {
                 return self.atlas.chart_parameter(to, xi);
             }
         }
+        if let Some(uv2) = self.atlas.adjacent_parameter(from, uv, to) {
+            return uv2;
+        }
         let x = self.atlas.jet(from, uv).x;
-        self.newton_on(&x, to, ([-1.0; 2], [2.0; 2])).xi
+        let bounds = if self.atlas.is_subdivision() { UNIT } else { ([-1.0; 2], [2.0; 2]) };
+        self.newton_on(&x, to, bounds).xi
     }
 }
