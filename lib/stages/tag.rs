@@ -74,6 +74,10 @@ pub enum TagError {
     FacetOrders { pair: String, orders: [usize; 2] },
     #[error("pair '{pair}': a subdivision master is bicubic where regular (orders [4, 4]); orders {orders:?} were given")]
     SubdivisionOrders { pair: String, orders: [usize; 2] },
+    #[error("pair '{pair}': master face set '{master}' cannot carry a Catmull–Clark surface: {why}")]
+    Subdivision { pair: String, master: String, why: String },
+    #[error("pair '{pair}': master face set '{master}' has no smooth master (a `facet` master takes any quad set):\n  one grid: {grid}\n  several grids: {patches}\n  subdivision: {subdivision}")]
+    NoSmoothMaster { pair: String, master: String, grid: String, patches: String, subdivision: String },
 }
 
 impl PairSpec {
@@ -164,28 +168,62 @@ pub fn build_pair(mesh: &Mesh, spec: &PairSpec) -> Result<ContactPair, TagError>
             if let Some(o) = spec.orders.filter(|&o| o != [4, 4]) {
                 return Err(TagError::SubdivisionOrders { pair, orders: o });
             }
-            check(make(MasterKind::Subdivision, [4, 4], net_of(NetChoice::Quads)?))
+            let net = net_of(NetChoice::Quads)?;
+            subdivision_check(mesh, &spec.master, &net).map_err(|why| TagError::Subdivision { pair: pair.clone(), master: spec.master.clone(), why })?;
+            check(make(MasterKind::Subdivision, [4, 4], net))
         }
         MasterKind::Patch => check(make(MasterKind::Bspline, bspline_orders, net_of(NetChoice::Grid)?)),
         MasterKind::Periodic => check(make(MasterKind::Bspline, bspline_orders, net_of(NetChoice::Periodic)?)),
         MasterKind::Multipatch => check(make(MasterKind::Bspline, bspline_orders, net_of(NetChoice::Patches)?)),
         MasterKind::Bspline => {
-            let net = net_of(NetChoice::Auto)?;
-            match net.shape {
-                NetShape::Quads(_) => Ok(make(MasterKind::Subdivision, [4, 4], net)),
-                NetShape::Patches(_) => {
-                    // several grids too small for the orders: the smooth surface of any quad set
+            // one grid, a closed grid, several grids, any quad surface: the first that fits
+            let grid = match master_net(mesh, &spec.master, NetChoice::Grid) {
+                Ok(net) => return check(make(MasterKind::Bspline, bspline_orders, net)),
+                Err(e @ (NetError::UnknownFaceSet { .. } | NetError::Empty { .. } | NetError::SpansTwoBodies { .. } | NetError::Branch { .. } | NetError::Degenerate { .. })) => return Err(master_err(e)),
+                Err(e) => e.to_string(),
+            };
+            if let Ok(net) = master_net(mesh, &spec.master, NetChoice::Periodic) {
+                return check(make(MasterKind::Bspline, bspline_orders, net));
+            }
+            let patches = match master_net(mesh, &spec.master, NetChoice::Patches) {
+                Ok(net) => {
                     let p = make(MasterKind::Bspline, bspline_orders, net);
-                    if p.check_orders().is_ok() {
-                        Ok(p)
-                    } else {
-                        Ok(make(MasterKind::Subdivision, [4, 4], net_of(NetChoice::Quads)?))
+                    match p.check_orders() {
+                        Ok(()) => return Ok(p),
+                        Err(e) => format!("it splits into {}, too small for orders {bspline_orders:?}: {e}", p.net.describe()),
                     }
                 }
-                _ => check(make(MasterKind::Bspline, bspline_orders, net)),
+                Err(e) => e.to_string(),
+            };
+            let net = net_of(NetChoice::Quads)?;
+            match subdivision_check(mesh, &spec.master, &net) {
+                Ok(()) => Ok(make(MasterKind::Subdivision, [4, 4], net)),
+                Err(subdivision) => Err(TagError::NoSmoothMaster { pair, master: spec.master.clone(), grid, patches, subdivision }),
             }
         }
     }
+}
+
+/// Whether the Catmull–Clark surface can be built on `net` (its boundary nodes in at
+/// most 2 faces, valences 3–14), the culprit named by gmsh tags.
+fn subdivision_check(mesh: &Mesh, master: &str, net: &MasterNet) -> Result<(), String> {
+    use crate::spline::subdivision::SubdivisionError as E;
+    let Err(e) = crate::spline::Atlas::subdivision(net.nodes.len(), net.cells()) else { return Ok(()) };
+    let node = |k: u32| net.nodes.get(k as usize).and_then(|&n| mesh.node_tags.get(n as usize)).copied().unwrap_or(k as u64);
+    let face = |f: usize| {
+        let set = mesh.face_set(master);
+        let quad = set.and_then(|s| s.quad_tags.get(f)).copied().unwrap_or(f as u64);
+        format!("quad {quad}")
+    };
+    Err(match e {
+        E::UnsupportedBoundaryNode { node: k, faces } => format!("boundary node {} (gmsh tag) lies in {faces} faces: concave corners and extraordinary boundary nodes are not supported (boundary nodes must lie in 1 or 2 faces)", node(k)),
+        E::ValenceTooLow { node: k, valence } => format!("interior node {} (gmsh tag) has valence {valence}; Catmull–Clark needs at least 3", node(k)),
+        E::ValenceTooHigh { node: k, valence, max } => format!("interior node {} (gmsh tag) has valence {valence}, above the supported {max}", node(k)),
+        E::NonManifoldVertex { node: k, .. } => format!("the faces around node {} (gmsh tag) do not form one fan", node(k)),
+        E::SupportTooLarge { face: f, nodes, max } => format!("{} depends on {nodes} nodes, more than {max}", face(f)),
+        E::StencilIncomplete { face: f } => format!("the faces around the corners of {} do not form a Catmull–Clark stencil (a mesh too small or folded there)", face(f)),
+        other => other.to_string(),
+    })
 }
 
 /// Build every pair (names unique, at least one pair).

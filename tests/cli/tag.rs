@@ -131,19 +131,37 @@ fn refused(mesh: &Mesh, pair: &str, needles: &[&str]) {
 
 #[test]
 fn hole_is_refused() {
-    // 3×3 top faces minus the centre one (hex 4).
-    refused(&block_with_top([3, 3, 1], |e| e != 4), "p:origin:m", &["pair 'p': master face set 'm' has a hole", "2 closed loops"]);
+    // 3×3 top faces minus the centre one (hex 4): no grid, pieces of one face each,
+    // and concave corners the subdivision surface does not take. Each reason is given.
+    let m = block_with_top([3, 3, 1], |e| e != 4);
+    refused(&m, "p:origin:m", &["pair 'p': master face set 'm' has no smooth master", "one grid: face set 'm' has a hole", "2 closed loops", "8 grids (2 × 2, ", "too small for orders [3, 3]", "subdivision: boundary node", "lies in 3 faces"]);
+    refused(&m, "p:origin:m:patch", &["pair 'p': master face set 'm' has a hole", "2 closed loops"]);
+    refused(&m, "p:origin:m:subdivision", &["cannot carry a Catmull–Clark surface: boundary node", "lies in 3 faces"]);
+    // facets take any quad set; bilinear B-spline patches fit the one-face pieces
+    let dir = tempdir();
+    let p = write_mesh(dir.path(), &m);
+    let (o, out) = tag(dir.path(), &p, &["f:origin:m:facet", "b:origin:m:bspline:2:2"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(e.contains("against master 'm', 8 quads on 16 nodes, facet orders [2, 2]") && e.contains("8 grids (2 × 2, 2 × 2, 2 × 2, 2 × 2, 2 × 2, 2 × 2, 2 × 2, 2 × 2), multipatch bspline orders [2, 2]"), "{e}");
+    assert_eq!(ContactModel::read(&out).unwrap().pairs.len(), 2);
 }
 
 #[test]
 fn l_shape_is_refused() {
     // 2×2 top faces minus hex 3's: the re-entrant corner is named with its faces.
-    refused(&block_with_top([2, 2, 1], |e| e != 3), "p:origin:m", &["non-rectangular outline", "re-entrant corner in 3 faces", "quad 501 (face 1 of hex 1)"]);
+    let m = block_with_top([2, 2, 1], |e| e != 3);
+    refused(&m, "p:origin:m:patch", &["non-rectangular outline", "re-entrant corner in 3 faces", "quad 501 (face 1 of hex 1)"]);
+    refused(&m, "p:origin:m", &["has no smooth master", "non-rectangular outline", "re-entrant corner in 3 faces", "subdivision: boundary node 14 (gmsh tag) lies in 3 faces"]);
 }
 
 #[test]
 fn faces_meeting_at_a_point_are_refused() {
-    refused(&block_with_top([2, 2, 1], |e| e == 0 || e == 3), "p:origin:m", &["non-rectangular outline", "4 boundary edges meet"]);
+    let m = block_with_top([2, 2, 1], |e| e == 0 || e == 3);
+    refused(&m, "p:origin:m:patch", &["non-rectangular outline", "4 boundary edges meet"]);
+    for kind in ["bspline", "facet", "subdivision"] {
+        refused(&m, &format!("p:origin:m:{kind}"), &["is not a manifold surface at node 14 (gmsh tag)", "quad 501 (face 1 of hex 1)", "quad 504 (face 1 of hex 4)"]);
+    }
 }
 
 #[test]
@@ -171,7 +189,7 @@ fn orders_too_high_for_the_net_are_refused() {
     let dir = tempdir();
     let mesh = parisch_scmesh(dir.path());
     let (o, out) = tag(dir.path(), &mesh, &["c:upper_bottom:lower_top:bspline:3:5"]);
-    assert_fails(&o, 2, &["pair 'c': master 'lower_top' is a 4 × 4 node net, direction 2", "a 4-node row cannot carry order 5"], &out);
+    assert_fails(&o, 2, &["pair 'c': master 'lower_top' is a 4 × 4 grid: a 4-node row cannot carry order 5"], &out);
     let (o, out) = tag(dir.path(), &mesh, &["c:upper_bottom:lower_top:bspline:3:7"]);
     assert_fails(&o, 2, &["order 7 exceeds the supported maximum 6"], &out);
     let (o, out) = tag(dir.path(), &mesh, &["c:upper_bottom:lower_top:bspline:1:3"]);
