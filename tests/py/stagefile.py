@@ -82,8 +82,13 @@ def _pairs(records, metas):
     pairs = []
     for k, p in enumerate(metas):
         p = dict(p)
-        for key in ("slave_nodes", "net", "knots_1", "knots_2"):
-            p[key] = a[f"{k}/{key}"]
+        # one-grid nets carry net + knots; several grids nodes + patch/<q>/net;
+        # free quads nodes + faces (docs/formats.md, .sccontact 1.1)
+        for key in ("slave_nodes", "net", "knots_1", "knots_2", "nodes", "faces"):
+            if f"{k}/{key}" in a:
+                p[key] = a[f"{k}/{key}"]
+        for q in range(len(p.get("patches") or [])):
+            p.setdefault("patch_nets", []).append(a[f"{k}/patch/{q}/net"])
         pairs.append(p)
     return pairs
 

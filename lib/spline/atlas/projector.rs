@@ -1,9 +1,11 @@
 //! Closest-point projection onto an [`Atlas`] (eq. 2.2 on a surface of many charts).
 //!
-//! 1. The chart tree gives, nearest box first, every chart that can hold a closer
-//!    point than the best found so far; on each, a box-constrained Newton iteration
-//!    over the unit square (the one of [`crate::spline::projection`]) finds the
-//!    chart's closest point. The nearest wins.
+//! 1. Every chart carries `S × S` surface samples, refreshed with the tree. The tree
+//!    finds the nearest sample (distances only; the chart of the last search seeds
+//!    the bound), then, nearest box first, every chart that can hold a point closer
+//!    than the best found so far; on each, a box-constrained Newton iteration over the
+//!    unit square (the one of [`crate::spline::projection`]), started from the chart's
+//!    nearest sample, finds the chart's closest point. The nearest wins.
 //! 2. Hysteresis, as for the single facet net: the chart `prev` of the last search is
 //!    kept while its foot point is no farther than the best by 1e-6 of the surface's
 //!    size (1e-4 where both are orthogonal projections), so a node on a shared edge
@@ -16,6 +18,8 @@
 //!      [`SurfacePoint::hold_on_crease`]);
 //!    - a smooth join: nothing, the neighbouring chart holds the orthogonal foot point.
 
+use rayon::prelude::*;
+
 use super::super::projection::{newton, NewtonResult};
 use super::super::{Projection, ProjectionOptions, SplineError, SurfacePoint, Vec3};
 use super::tree::ChartTree;
@@ -26,11 +30,19 @@ use super::{Atlas, EdgeKind};
 pub struct AtlasProjector {
     atlas: Atlas,
     tree: ChartTree,
+    /// `samples[S² c + i + S j]` = x̄ of chart c at ((i + ½)/S, (j + ½)/S).
+    samples: Vec<Vec3>,
     scale: f64,
     pub options: ProjectionOptions,
 }
 
 const UNIT: ([f64; 2], [f64; 2]) = ([0.0; 2], [1.0; 2]);
+/// Samples per direction and chart.
+const S: usize = 3;
+
+fn sample_uv(k: usize) -> [f64; 2] {
+    [((k % S) as f64 + 0.5) / S as f64, ((k / S) as f64 + 0.5) / S as f64]
+}
 
 impl AtlasProjector {
     pub fn new(mut atlas: Atlas, x: &[Vec3]) -> Result<Self, SplineError> {
@@ -40,7 +52,30 @@ impl AtlasProjector {
         let inflate = if atlas.is_subdivision() { 0.1 } else { 0.0 };
         let tree = ChartTree::new(atlas.n_charts(), &|c| atlas.support(c), x, inflate);
         let scale = tree.diagonal();
-        Ok(Self { atlas, tree, scale, options: ProjectionOptions::default() })
+        let mut s = Self { samples: vec![Vec3::zeros(); S * S * atlas.n_charts()], atlas, tree, scale, options: ProjectionOptions::default() };
+        s.refit_samples();
+        Ok(s)
+    }
+
+    fn refit_samples(&mut self) {
+        let atlas = &self.atlas;
+        self.samples.par_chunks_mut(S * S).enumerate().for_each(|(c, out)| {
+            for (k, y) in out.iter_mut().enumerate() {
+                *y = atlas.jet(c, sample_uv(k)).x;
+            }
+        });
+    }
+
+    /// The nearest sample of `chart` to `p`: (squared distance, its (u, v)).
+    fn nearest_sample(&self, p: &Vec3, chart: usize) -> (f64, [f64; 2]) {
+        let mut best = (f64::INFINITY, [0.5; 2]);
+        for (k, y) in self.samples[S * S * chart..S * S * (chart + 1)].iter().enumerate() {
+            let d2 = (y - p).norm_squared();
+            if d2 < best.0 {
+                best = (d2, sample_uv(k));
+            }
+        }
+        best
     }
 
     /// New master node positions: refits the chart tree, O(charts).
@@ -49,6 +84,7 @@ impl AtlasProjector {
         let atlas = &self.atlas;
         self.tree.refit(&|c| atlas.support(c), x);
         self.scale = self.tree.diagonal();
+        self.refit_samples();
         Ok(())
     }
 
@@ -61,10 +97,14 @@ impl AtlasProjector {
     }
 
     fn newton_on(&self, p: &Vec3, chart: usize, (lo, hi): ([f64; 2], [f64; 2])) -> NewtonResult {
-        let o = &self.options;
         let mid = [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])];
+        self.newton_from(p, chart, mid, (lo, hi))
+    }
+
+    fn newton_from(&self, p: &Vec3, chart: usize, start: [f64; 2], (lo, hi): ([f64; 2], [f64; 2])) -> NewtonResult {
+        let o = &self.options;
         let step = [(hi[0] - lo[0]).max(1.0), (hi[1] - lo[1]).max(1.0)];
-        newton(|uv| self.atlas.jet(chart, uv), p, mid, (lo, hi), step, o.tol * self.scale, o.max_iterations)
+        newton(|uv| self.atlas.jet(chart, uv), p, start, (lo, hi), step, o.tol * self.scale, o.max_iterations)
     }
 
     /// Whether (p − x̄)·ā_α = 0 holds in each direction.
@@ -85,14 +125,38 @@ impl AtlasProjector {
 
     /// Closest point with hysteresis on the chart `prev` (module docs, steps 1–3).
     pub fn project_keeping(&self, p: &Vec3, prev: Option<usize>) -> (Projection, usize) {
-        let mut best: Option<(f64, NewtonResult, usize)> = None;
-        self.tree.query(p, f64::INFINITY, |chart, _| {
-            let res = self.newton_on(p, chart, UNIT);
-            let d2 = (p - res.jet.x).norm_squared();
-            if best.as_ref().is_none_or(|b| d2 < b.0) {
-                best = Some((d2, res, chart));
+        let prev = prev.filter(|&c| c < self.atlas.n_charts());
+        // the nearest sample: an upper bound on the distance, and where to start
+        let mut seed = (f64::INFINITY, 0usize, [0.5; 2]);
+        if let Some(c) = prev {
+            let (d2, uv) = self.nearest_sample(p, c);
+            seed = (d2, c, uv);
+        }
+        self.tree.query(p, seed.0, |chart, _| {
+            let (d2, uv) = self.nearest_sample(p, chart);
+            if d2 < seed.0 {
+                seed = (d2, chart, uv);
             }
-            best.as_ref().map_or(f64::INFINITY, |b| b.0)
+            seed.0
+        });
+        let mut best: Option<(f64, NewtonResult, usize)> = None;
+        if seed.0.is_finite() {
+            let res = self.newton_from(p, seed.1, seed.2, UNIT);
+            best = Some(((p - res.jet.x).norm_squared(), res, seed.1));
+        }
+        // a chart can hold a closer point only if its box is within the best distance
+        // (a hair wider: round-off in the samples' distances)
+        let bound = best.as_ref().map_or(f64::INFINITY, |b| b.0.min(seed.0)) * (1.0 + 1e-12);
+        self.tree.query(p, bound, |chart, _| {
+            if chart != seed.1 {
+                let (_, uv) = self.nearest_sample(p, chart);
+                let res = self.newton_from(p, chart, uv, UNIT);
+                let d2 = (p - res.jet.x).norm_squared();
+                if best.as_ref().is_none_or(|b| d2 < b.0) {
+                    best = Some((d2, res, chart));
+                }
+            }
+            best.as_ref().map_or(f64::INFINITY, |b| b.0 * (1.0 + 1e-12))
         });
         let Some((d2, mut res, mut chart)) = best else {
             let nan = Projection { xi: [f64::NAN; 2], x_bar: Vec3::from_element(f64::NAN), g: f64::NAN, inside: false, iterations: 0, converged: false, clamped: [false; 2] };

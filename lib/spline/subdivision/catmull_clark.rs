@@ -174,6 +174,12 @@ pub(super) struct ValenceTables {
     /// Deepest level: `λ^levels ≤ 1e-16`; closer to the vertex the point moves out
     /// to `max(s, t) = 2^{−levels}`.
     pub levels: u32,
+    /// `B^{2^j}`, j = 0, 1, …, row-major `m × m`, with `B = A − 1 w_0ᵀ` (A without its
+    /// eigenvalue 1: `A^k = B^k + 1 w_0ᵀ`, as `A 1 = 1`, `w_0ᵀ A = w_0ᵀ`, `w_0ᵀ 1 = 1`).
+    /// k levels cost one product per set bit of k (at most 7 for k ≤ 127) instead of
+    /// k; B's powers decay like λ^{2^j}, so they keep the subdominant part (the
+    /// derivatives) to relative precision, which powers of A would bury under 1.
+    powers: Vec<Vec<f64>>,
 }
 
 impl ValenceTables {
@@ -210,7 +216,29 @@ impl ValenceTables {
             w0[2 + 2 * i] = 1.0 / (nf * (nf + 5.0));
         }
         let levels = (1e-16f64.ln() / subdominant_eigenvalue(n).ln()).ceil() as u32;
-        Ok(Self { m, a, r, w0, levels })
+        let mut b = a.clone();
+        for i in 0..m {
+            for j in 0..m {
+                b[i * m + j] -= w0[j];
+            }
+        }
+        let mut powers = vec![b];
+        while (1u32 << powers.len()) <= levels {
+            let p = powers.last().expect("A itself is first");
+            let mut sq = vec![0.0; m * m];
+            for i in 0..m {
+                for l in 0..m {
+                    let pil = p[i * m + l];
+                    if pil != 0.0 {
+                        for j in 0..m {
+                            sq[i * m + j] += pil * p[l * m + j];
+                        }
+                    }
+                }
+            }
+            powers.push(sq);
+        }
+        Ok(Self { m, a, r, w0, levels, powers })
     }
 
     /// `A[i][j]`.
@@ -264,14 +292,22 @@ impl ValenceTables {
             }
         }
         self.deflate(n_rows, out);
-        // · A^k
+        // · A^k, as the product of A^{2^j} over the set bits j of k (powers of A
+        // commute); the derivative rows deflated after each product
         let mut next: Rows = [[0.0; super::super::MAX_NODES]; bicubic::N_ROWS];
-        for _ in 0..k {
+        for (j, aj) in self.powers.iter().enumerate() {
+            if k & (1 << j) == 0 {
+                continue;
+            }
             for (row_next, row) in next.iter_mut().zip(out.iter()).take(n_rows) {
-                row_next[..m].fill(0.0);
+                // row · A^{2^j} = row · B^{2^j} + (row · 1) w_0ᵀ
+                let sum: f64 = row[..m].iter().sum();
+                for (o, &w) in row_next[..m].iter_mut().zip(&self.w0) {
+                    *o = sum * w;
+                }
                 for (i, &ri) in row[..m].iter().enumerate() {
                     if ri != 0.0 {
-                        for (o, &x) in row_next[..m].iter_mut().zip(&self.a[i * m..(i + 1) * m]) {
+                        for (o, &x) in row_next[..m].iter_mut().zip(&aj[i * m..(i + 1) * m]) {
                             *o += ri * x;
                         }
                     }
