@@ -217,3 +217,42 @@ increments: {count: 5, max_cutbacks: 1}\n";
     let its: usize = r.increments.iter().map(|i| i.info.iterations.len() - 1).sum();
     assert!(its <= 100, "{its} Newton corrections (measured 80)");
 }
+
+/// 3D Hertz (issue 26, `pipelines/hertz3d.yaml`): a stiff ball pressed onto a soft
+/// block, the ball's surface the master as a free quad mesh with extraordinary nodes,
+/// once as the Catmull–Clark limit surface (`bspline` → subdivision) and once as
+/// facets, on the same mesh; `docs/scripts/hertz3d.py` compares the block's nodal
+/// pressures with the closed form for the measured force.
+/// Measured (refine 1, slave spacing 0.15, a ≈ 0.885, 113 active nodes):
+/// subdivision p0 +1.09 %, a_fit −0.53 %, profile RMS 0.0171; facets p0 +5.80 %,
+/// a_fit −0.49 %, RMS 0.0213. At refine 1.4 (docs/validation/masters.md) the
+/// subdivision master's p0 error stays within 1.5 % while the facets' stays above
+/// 4 %: the facets' peak is the faceted sphere's, not the mesh's. Asserted: the
+/// subdivision peak within 3 % (twice the mesh-converged figure), the facets' peak
+/// error at least twice the subdivision's, both contact radii within 2 %, the
+/// subdivision profile closer to Hertz than the facets', and the RMS pinned to ±5 %
+/// (a change of method moves it by more; it is then to be measured again).
+#[test]
+fn hertz3d_subdivision_master_beats_facets() {
+    let dir = staged_meshes(&["hertz3d.msh"]);
+    std::fs::copy(repo().join("pipelines/hertz3d.yaml"), dir.path().join("pipelines/hertz3d.yaml")).unwrap();
+    let o = run("sc-pipeline", &["pipelines/hertz3d.yaml"], dir.path());
+    assert!(o.status.success(), "hertz3d.yaml: {}", stderr(&o));
+    assert!(stderr(&o).contains("subdivision orders [4, 4]"), "sc-tag's choice: {}", stderr(&o));
+    let mut got = Vec::new();
+    for stem in ["hertz3d", "hertz3d-facet"] {
+        let scres = dir.path().join(format!("pipelines/out/{stem}.scres"));
+        let e1 = Path::new("--E1");
+        let (v1, e2, v2) = (Path::new("2e5"), Path::new("--E2"), Path::new("200"));
+        let j = json("../../docs/scripts/hertz3d.py", &[&scres, e1, v1, e2, v2]).remove(0);
+        eprintln!("{stem}: F {:.4}, p0 err {:+.4}, a_fit err {:+.4}, rms {:.5}, active {}", f(&j, &["F"]), f(&j, &["p0_err"]), f(&j, &["a_fit_err"]), f(&j, &["profile_rms_err"]), f(&j, &["active"]));
+        assert!((f(&j, &["F"]) - 25.4).abs() < 0.5, "{stem}: F = {}", f(&j, &["F"]));
+        assert!(f(&j, &["a_fit_err"]).abs() < 0.02, "{stem}: contact radius error {}", f(&j, &["a_fit_err"]));
+        got.push((f(&j, &["p0_err"]), f(&j, &["profile_rms_err"])));
+    }
+    let ((p_cc, rms_cc), (p_f, rms_f)) = (got[0], got[1]);
+    assert!(p_cc.abs() < 0.03, "subdivision: peak pressure error {p_cc}");
+    assert!(p_f.abs() > 2.0 * p_cc.abs(), "facets {p_f} against subdivision {p_cc}");
+    assert!(rms_cc < rms_f, "profile RMS: subdivision {rms_cc}, facets {rms_f}");
+    assert!((rms_cc / 0.01705 - 1.0).abs() < 0.05, "subdivision profile RMS {rms_cc} (measured 0.01705)");
+}
