@@ -3,6 +3,8 @@
 //!
 //! | file          | concept |
 //! |---------------|---------|
+//! | [`settings`]  | a pair's settings as plain data: enforcement, integration, mortar bases |
+//! | [`definition`] | one pair as the problem defines it: the tagged pair, its settings, areas |
 //! | [`net`]       | a master face set ordered into the a × b control net P_{i,j} (eq. 5.2), outward n̄ |
 //! | [`tributary`] | slave tributary areas A_s (eq. 6.1) |
 //! | [`element`]   | one slave node against the master: g_N, t_N, residual and tangent (eqs. 4.2–4.3, 6.2–6.5) |
@@ -14,6 +16,7 @@
 //! | [`adjust`]    | slave nodes moved onto the master before the first increment (stress-free) |
 
 pub mod adjust;
+pub mod definition;
 pub mod dual;
 pub mod element;
 pub mod friction;
@@ -21,6 +24,7 @@ pub mod master;
 pub mod mortar;
 pub mod net;
 pub mod pair;
+pub mod settings;
 pub mod tributary;
 
 pub use net::{control_net, ControlNet, NetError};
