@@ -65,7 +65,7 @@ use nalgebra::Vector3;
 use self::ffi::*;
 use super::block_rows::BlockRows;
 use super::linear::{FactorInfo, Factorization, LinearSolver, LinearSolverError, SolveReport, SolverTimings, Symmetry};
-use super::ranks::{owned_nodes, Reduction};
+use super::ranks::owned_nodes;
 pub use runtime::{finalize, initialize, PetscError};
 
 /// Every PETSc call of the process goes through this lock: PETSc's global state
@@ -368,7 +368,7 @@ impl LinearSolver for PetscKrylov {
         // a non-finite value stops every rank (the calls that follow are collective)
         let bad = values.iter().position(|v| !v.is_finite());
         let mut any_bad = [f64::from(u8::from(bad.is_some()))];
-        runtime::reduce_over_ranks(&mut any_bad, Reduction::Max).map_err(|e| LinearSolverError::Backend(e.to_string()))?;
+        runtime::max_over_ranks(&mut any_bad).map_err(|e| LinearSolverError::Backend(e.to_string()))?;
         if any_bad[0] > 0.0 {
             return Err(match bad {
                 Some(index) => LinearSolverError::NonFinite { index },
@@ -380,7 +380,7 @@ impl LinearSolver for PetscKrylov {
         // only this rank's rows are complete (and inserted); whether the tangent is
         // indefinite is decided by all ranks together, as what follows is collective
         let mut count = [self.non_positive.iter().filter(|&&g| g >= 3 * first && g < 3 * last).count() as f64];
-        runtime::reduce_over_ranks(&mut count, Reduction::Sum).map_err(|e| LinearSolverError::Backend(e.to_string()))?;
+        runtime::sum_over_ranks(&mut count).map_err(|e| LinearSolverError::Backend(e.to_string()))?;
         self.indefinite_total = count[0] as usize;
         unsafe {
             for i in first..last {
