@@ -23,7 +23,7 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 
 use crate::format::csv::{CsvError, Table};
-use crate::format::pipeline::resolve;
+use crate::format::stage::files::resolve;
 use crate::format::stage::{write_atomic, StageError};
 
 use super::exit_code;
