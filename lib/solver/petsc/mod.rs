@@ -68,11 +68,6 @@ use super::linear::{FactorInfo, Factorization, LinearSolver, LinearSolverError, 
 use super::ranks::owned_nodes;
 pub use runtime::{finalize, initialize, PetscError};
 
-/// Every PETSc call of the process goes through this lock: PETSc's global state
-/// (options, logging, memory tracking) is not thread-safe, and tests run solvers on
-/// several threads.
-static LOCK: Mutex<()> = Mutex::new(());
-
 /// Settings of [`PetscKrylov`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct PetscSettings {
@@ -148,7 +143,7 @@ pub struct PetscKrylov {
     timings: SolverTimings,
 }
 
-// The handles are only touched under LOCK, by the thread that owns the solver.
+// The handles are only touched under runtime::LOCK, by the thread that owns the solver.
 unsafe impl Send for PetscKrylov {}
 
 impl PetscKrylov {
@@ -329,7 +324,7 @@ impl PetscKrylov {
 
 impl Drop for PetscKrylov {
     fn drop(&mut self) {
-        let _guard = LOCK.lock().unwrap_or_else(|p| p.into_inner());
+        let _guard = runtime::LOCK.lock().unwrap_or_else(|p| p.into_inner());
         self.release();
     }
 }
@@ -341,7 +336,7 @@ impl LinearSolver for PetscKrylov {
 
     fn analyse(&mut self, pattern: SymbolicSparseColMatRef<'_, usize>, symmetry: Symmetry) -> Result<(), LinearSolverError> {
         let start = Instant::now();
-        let _guard = LOCK.lock().unwrap_or_else(|p| p.into_inner());
+        let _guard = runtime::LOCK.lock().unwrap_or_else(|p| p.into_inner());
         self.release();
         self.rows = None;
         self.block_values = Vec::new();
@@ -361,7 +356,7 @@ impl LinearSolver for PetscKrylov {
 
     fn factor(&mut self, values: &[f64]) -> Result<FactorInfo, LinearSolverError> {
         let start = Instant::now();
-        let _guard = LOCK.lock().unwrap_or_else(|p| p.into_inner());
+        let _guard = runtime::LOCK.lock().unwrap_or_else(|p| p.into_inner());
         let Some(rows) = self.rows.as_ref() else {
             return Err(LinearSolverError::Order("factor", "analyse"));
         };
@@ -423,7 +418,7 @@ impl LinearSolver for PetscKrylov {
 
     fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolverError> {
         let start = Instant::now();
-        let _guard = LOCK.lock().unwrap_or_else(|p| p.into_inner());
+        let _guard = runtime::LOCK.lock().unwrap_or_else(|p| p.into_inner());
         if self.mat.is_null() || self.ksp.is_null() {
             return Err(LinearSolverError::Order("solve", "factor"));
         }

@@ -5,9 +5,14 @@
 //! agrees on its rank from the start, and call [`finalize`] before it exits.
 
 use std::ffi::{c_int, CStr};
-use std::sync::OnceLock;
+use std::sync::{Mutex, OnceLock};
 
 use super::ffi::*;
+
+/// Every PETSc call of the process goes through this lock: PETSc's global state
+/// (options, logging, memory tracking) is not thread-safe, and tests run solvers on
+/// several threads.
+pub(super) static LOCK: Mutex<()> = Mutex::new(());
 
 /// A PETSc call that failed: the function, PETSc's code and its message.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -20,7 +25,7 @@ static STARTED: OnceLock<Result<(), PetscError>> = OnceLock::new();
 pub fn initialize() -> Result<(), PetscError> {
     STARTED
         .get_or_init(|| {
-            let _guard = super::LOCK.lock().unwrap_or_else(|p| p.into_inner());
+            let _guard = LOCK.lock().unwrap_or_else(|p| p.into_inner());
             let code = unsafe { sc_initialize() };
             if code != 0 {
                 return Err(PetscError(describe("PetscInitialize", code)));
@@ -42,7 +47,7 @@ pub fn is_initialized() -> bool {
 /// Stops PETSc and MPI (the program's last PETSc call; nothing may follow).
 pub fn finalize() {
     if is_initialized() {
-        let _guard = super::LOCK.lock().unwrap_or_else(|p| p.into_inner());
+        let _guard = LOCK.lock().unwrap_or_else(|p| p.into_inner());
         unsafe {
             PetscFinalize();
         }
