@@ -24,9 +24,8 @@ use nalgebra::{DMatrix, DVector};
 
 use super::{Mortar, Transfer};
 use crate::contact::element::zero_element;
-use crate::contact::law::{ContactElementError, ContactState, NormalLaw};
 use crate::contact::friction::tangential_contact;
-use crate::contact::law::FrictionLaw;
+use crate::contact::law::{ContactElementError, ContactState, FrictionLaw, NormalLaw};
 use crate::contact::master::Projector;
 use crate::spline::{SurfacePoint, Vec3};
 
