@@ -150,7 +150,7 @@ pub struct PairCheck {
     pub master: String,
     pub master_kind: &'static str,
     pub orders: [usize; 2],
-    pub net: [usize; 2],
+    pub net: String,
     pub rows: Vec<SlaveRow>,
     /// h (mean master net edge), the capture distance 0.5 h and the edge tolerance.
     pub h_master: f64,
@@ -317,7 +317,7 @@ pub fn check_pair(mesh: &Mesh, def: &ContactDefinition, X_solve: &[V3], adjustme
         master: pair.master.clone(),
         master_kind: pair.master_kind.name(),
         orders: pair.orders,
-        net: [pair.net.a, pair.net.b],
+        net: pair.net.describe(),
         rows,
         h_master: def.h_master,
         capture: solver.capture(),

@@ -87,11 +87,10 @@ pub fn master_cells_inward(mesh: &Mesh, X: &[V3], pair: &ContactPair) -> (usize,
         key.sort_unstable();
         owner.insert(key, f.element);
     }
-    let (a, b) = (pair.net.a, pair.net.b);
     let (mut inward, mut compared) = (0, 0);
-    for j in 0..b.saturating_sub(1) {
-        for i in 0..a.saturating_sub(1) {
-            let q = [pair.net.at(i, j), pair.net.at(i + 1, j), pair.net.at(i + 1, j + 1), pair.net.at(i, j + 1)];
+    for cell in pair.net.cells() {
+        {
+            let q = cell.map(|k| pair.net.nodes[k as usize]);
             let mut key = q;
             key.sort_unstable();
             let Some(&e) = owner.get(&key) else { continue };

@@ -26,8 +26,8 @@ fn range_text(r: Option<(f64, f64)>) -> String {
 fn pair_lines(p: &PairCheck, out: &mut Vec<String>) {
     let (inside, outside, failed) = p.counts();
     out.push(format!(
-        "contact pair '{}': slave {}, master face set {} ({} [{}, {}], net {} × {})",
-        p.name, p.slave, p.master, p.master_kind, p.orders[0], p.orders[1], p.net[0], p.net[1]
+        "contact pair '{}': slave {}, master face set {} ({} [{}, {}], net: {})",
+        p.name, p.slave, p.master, p.master_kind, p.orders[0], p.orders[1], p.net
     ));
     out.push(format!("  slave nodes           {}", p.rows.len()));
     let reasons = p.failures().iter().map(|(r, n)| format!("{n} {}", r.word())).collect::<Vec<_>>().join(", ");

@@ -18,6 +18,8 @@
 //! | [`adjust`]    | slave nodes moved onto the master before the first increment (stress-free) |
 
 pub mod adjust;
+#[cfg(test)]
+mod atlas_fd;
 pub mod definition;
 pub mod dual;
 pub mod dual_element;
@@ -31,4 +33,4 @@ pub mod pair;
 pub mod settings;
 pub mod tributary;
 
-pub use net::{control_net, ControlNet, NetError};
+pub use net::{control_net, master_net, ControlNet, MasterNet, NetChoice, NetError, NetShape, PatchNet};

@@ -28,7 +28,7 @@ use super::settings::{Enforcement, Integration};
 use super::master::Projector;
 use super::mortar::element::{mortar_contact, NodeFriction};
 use super::mortar::{Mortar, MortarError};
-use crate::spline::{BSplinePatch, BSplineProjector, FacetProjector, FacetSurface, Projection, SplineError, SurfacePoint, Vec3};
+use crate::spline::{Projection, SplineError, SurfacePoint, Vec3};
 
 /// Where a slave node stands after the last search / state update.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -94,6 +94,8 @@ pub enum PairError {
     Master { pair: String, source: SplineError },
     #[error("contact pair '{pair}': {source}")]
     Mortar { pair: String, source: MortarError },
+    #[error("contact pair '{pair}': `integration: mortar` needs a master of one grid; this master is a {net} (use `integration: node`)")]
+    MortarNeedsGrid { pair: String, net: String },
     #[error("contact pair '{pair}': exchanging the search results between MPI ranks: {message}")]
     Exchange { pair: String, message: String },
 }
@@ -194,6 +196,11 @@ pub struct PairSolver {
     /// commit), so its slip is measured from where it first touched.
     xi_n_committed: Vec<[f64; 2]>,
     t_t_n_committed: Vec<[f64; 2]>,
+    /// Atlas masters: the chart ξ̄_n and t_{Tα,n} are expressed on (`usize::MAX`:
+    /// the chart of the next search); the search moves the history to the chart the
+    /// node is on ([`Projector::transfer_history`]).
+    chart_n: Vec<usize>,
+    chart_n_committed: Vec<usize>,
     /// After [`Self::update_states`], frictional pairs: t_Tα, the traction vector,
     /// slip (else stick), the force on the slave node.
     pub t_t: Vec<[f64; 2]>,
@@ -240,13 +247,7 @@ impl PairSolver {
         let pair = &def.pair;
         let err = |source| PairError::Master { pair: pair.name.clone(), source };
         let x_net: Vec<Vec3> = pair.net.nodes.iter().map(|&n| x_ref[n as usize]).collect();
-        let (a, b) = (pair.net.a, pair.net.b);
-        let projector = match pair.master_kind {
-            MasterKind::Bspline => Projector::BSpline(BSplineProjector::new(BSplinePatch::new(a, b, pair.orders[0], pair.orders[1]).map_err(err)?, &x_net).map_err(err)?),
-            MasterKind::Facet => {
-                Projector::Facet(FacetProjector::new(FacetSurface::new(a, b).map_err(err)?, &x_net).map_err(err)?)
-            }
-        };
+        let projector = Projector::for_net(pair.master_kind, pair.orders, &pair.net, &x_net).map_err(err)?;
         let h_master = def.h_master;
         let settings = def.settings;
         let areas = def.areas.clone();
@@ -254,7 +255,15 @@ impl PairSolver {
         let mortar = match settings.integration {
             Integration::Node => None,
             Integration::Mortar => Some(
-                Mortar::new(&def.slave_faces, &pair.slave_nodes, x_ref, [a, b], &pair.net.nodes, settings.multipliers, settings.transfer)
+                Mortar::new(
+                    &def.slave_faces,
+                    &pair.slave_nodes,
+                    x_ref,
+                    pair.net.grid().map(|g| [g.a, g.b]).ok_or_else(|| PairError::MortarNeedsGrid { pair: pair.name.clone(), net: pair.net.describe() })?,
+                    &pair.net.nodes,
+                    settings.multipliers,
+                    settings.transfer,
+                )
                     .map_err(err)?
                     .map_err(|source| PairError::Mortar { pair: pair.name.clone(), source })?,
             ),
@@ -287,6 +296,8 @@ impl PairSolver {
             xi_n_committed: vec![[f64::NAN; 2]; n],
             t_t_n_committed: vec![[0.0; 2]; n],
             t_t_n: vec![[0.0; 2]; n],
+            chart_n: vec![usize::MAX; n],
+            chart_n_committed: vec![usize::MAX; n],
             t_t: vec![[0.0; 2]; n],
             t_t_vector: vec![Vec3::zeros(); n],
             slipping: vec![false; n],
@@ -367,6 +378,12 @@ impl PairSolver {
         for s in 0..self.slaves.len() {
             if self.xi_n[s][0].is_nan() && self.usable(s) {
                 self.xi_n[s] = self.projections[s].xi;
+                self.chart_n[s] = self.chart(s);
+            } else if self.projector.is_atlas() && self.usable(s) && self.chart_n[s] != self.chart(s) {
+                if self.chart_n[s] != usize::MAX {
+                    (self.xi_n[s], self.t_t_n[s]) = self.projector.transfer_history(self.chart_n[s], self.xi_n[s], self.t_t_n[s], self.chart(s));
+                }
+                self.chart_n[s] = self.chart(s);
             }
         }
         Ok(())
@@ -513,6 +530,15 @@ impl PairSolver {
         self.usable(s) && self.trial(s) < 0.0
     }
 
+    /// The atlas chart of slave `s`'s foot point (`usize::MAX` on other masters).
+    fn chart(&self, s: usize) -> usize {
+        if self.projector.is_atlas() {
+            self.cells[s].map_or(usize::MAX, |c| c[0])
+        } else {
+            usize::MAX
+        }
+    }
+
     fn normal_law(&self, s: usize) -> NormalLaw {
         NormalLaw { lambda_n: self.lambda_n[s], eps_n: self.settings.eps_n, area: self.areas[s], touch: self.touch }
     }
@@ -601,9 +627,11 @@ impl PairSolver {
         for s in 0..self.slaves.len() {
             if self.usable(s) {
                 self.xi_n[s] = self.projections[s].xi;
+                self.chart_n[s] = self.chart(s);
             }
         }
         self.xi_n_committed.copy_from_slice(&self.xi_n);
+        self.chart_n_committed.copy_from_slice(&self.chart_n);
     }
 
     /// Slip increment of slave `s` in this increment, (ξ̄ − ξ̄_n)^α ā_α.
@@ -744,6 +772,7 @@ impl PairSolver {
                 self.t_t_n[s] = self.t_t[s];
                 if self.slipping[s] {
                     self.xi_n[s] = self.projections[s].xi;
+                    self.chart_n[s] = self.chart(s);
                 }
             }
         }
@@ -795,9 +824,11 @@ impl PairSolver {
             // off the patch: forget the foot point, the next one found starts afresh
             self.xi_n[s] = if self.status[s] == SlaveStatus::Outside { [f64::NAN; 2] } else { self.projections[s].xi };
             self.t_t_n[s] = if self.status[s] == SlaveStatus::Active { self.t_t[s] } else { [0.0; 2] };
+            self.chart_n[s] = self.chart(s);
         }
         self.xi_n_committed.copy_from_slice(&self.xi_n);
         self.t_t_n_committed.copy_from_slice(&self.t_t_n);
+        self.chart_n_committed.copy_from_slice(&self.chart_n);
     }
 
     /// A restart: the converged history of an increment as a results file stores it
@@ -818,9 +849,12 @@ impl PairSolver {
                 _ => [0.0; 2],
             };
         }
+        // the chart of each ξ̄_n is that of the first search after the restart
+        self.chart_n.fill(usize::MAX);
         self.lambda_committed.copy_from_slice(&self.lambda_n);
         self.xi_n_committed.copy_from_slice(&self.xi_n);
         self.t_t_n_committed.copy_from_slice(&self.t_t_n);
+        self.chart_n_committed.copy_from_slice(&self.chart_n);
         self.augmentations = 0;
     }
 
@@ -829,6 +863,7 @@ impl PairSolver {
         self.lambda_n.copy_from_slice(&self.lambda_committed);
         self.xi_n.copy_from_slice(&self.xi_n_committed);
         self.t_t_n.copy_from_slice(&self.t_t_n_committed);
+        self.chart_n.copy_from_slice(&self.chart_n_committed);
         self.augmentations = 0;
     }
 }
@@ -863,7 +898,7 @@ mod tests {
             master_kind: kind,
             orders: if kind == MasterKind::Facet { [2, 2] } else { [3, 3] },
             slave_nodes: (30..70).collect(),
-            net: ControlNet { a, b, nodes: (0..30).collect() },
+            net: ControlNet { a, b, nodes: (0..30).collect() }.into(),
         };
         let settings = PairSettings { eps_n: 1e3, enforcement: Enforcement::Penalty, penetration_tolerance: 1e-3, max_augmentations: 0, update_halvings: 0, mu: 0.0, eps_t: 0.0, stabilization: 0.0, integration: Integration::Node, multipliers: Default::default(), transfer: Default::default() };
         let def = ContactDefinition { pair, settings, areas: vec![0.01; 40], slave_faces: Vec::new(), h_master: 0.2, eps_n_default: false, adjust: None, allow_flipped_master: false };

@@ -12,6 +12,12 @@
 //! C^{k−2} across every interior knot (sec. 5.1). The parameter domain is `[0, 1]`,
 //! cut into `m = n − k + 1` knot spans ("elements").
 //!
+//! A **periodic** direction (a tube closed on itself, [`KnotVector::periodic_uniform`])
+//! uses the unclamped uniform knots `ξ_j = (j − p)/n` of `n` wrapped control points:
+//! `n + p` basis functions over `n` spans of the domain `[0, 1]`, basis function
+//! `i ≥ n` belonging to control point `i − n`. The curve is C^{k−2} everywhere,
+//! the seam included.
+//!
 //! Knots are stored 0-based: `knots[0..k] = 0`, `knots[n..n+k] = 1`, and span `s`
 //! (0-based, `0 ≤ s < m`) is `[knots[k−1+s], knots[k+s])`. The last span is closed,
 //! so ξ = 1 belongs to span `m − 1`.
@@ -64,6 +70,37 @@ impl KnotVector {
             })
             .collect();
         Ok(Self { n, order, knots, inv_diff })
+    }
+
+    /// The unclamped uniform knot vector of a closed row of `n` control points of
+    /// order `k`: `n + k − 1` basis functions (the last `k − 1` are the first
+    /// control points again) and `n` spans on `[0, 1]` (`n ≥ k`).
+    pub fn periodic_uniform(n: usize, order: usize) -> Result<Self, SplineError> {
+        if order < 2 {
+            return Err(SplineError::OrderTooLow { order });
+        }
+        if order > MAX_ORDER {
+            return Err(SplineError::OrderTooHigh { order, max: MAX_ORDER });
+        }
+        if n < order {
+            return Err(SplineError::TooFewControlPoints { n, order });
+        }
+        let p = order - 1;
+        let n_basis = n + p;
+        let knots: Vec<f64> = (0..n_basis + order).map(|j| (j as f64 - p as f64) / n as f64).collect();
+        let inv_diff = (0..n)
+            .map(|s| {
+                let span = p + s;
+                let mut t = [[0.0; MAX_ORDER]; MAX_ORDER];
+                for (j, row) in t.iter_mut().enumerate().take(p + 1).skip(1) {
+                    for (r, v) in row.iter_mut().enumerate().take(j) {
+                        *v = 1.0 / (knots[span + r + 1] - knots[span + 1 + r - j]);
+                    }
+                }
+                t
+            })
+            .collect();
+        Ok(Self { n: n_basis, order, knots, inv_diff })
     }
 
     /// Number of control points (basis functions) `n`.
@@ -162,6 +199,9 @@ mod tests {
 
     #[test]
     fn span_search_half_open_and_right_end() {
+        let kv = KnotVector::periodic_uniform(6, 3).unwrap();
+        assert_eq!((kv.n(), kv.n_spans(), kv.span_bounds(0), kv.span_bounds(5)), (8, 6, (0.0, 1.0 / 6.0), (5.0 / 6.0, 1.0)));
+        assert_eq!(kv.find_span(0.5), 3);
         let kv = KnotVector::open_uniform(9, 3).unwrap(); // 7 spans
         let m = kv.n_spans();
         assert_eq!(m, 7);

@@ -12,6 +12,8 @@
 //! | [`facet`]       | the same control net read as bilinear 4-node facets (for comparison) |
 //! | [`span_tree`]   | AABB hierarchy over knot spans / facet cells, refittable |
 //! | [`projection`]  | closest-point projection, eq. 2.2 (global search + box-constrained Newton) |
+//! | [`subdivision`] | Catmull–Clark limit surface of any manifold quad control mesh (exact evaluation, basis) |
+//! | [`atlas`]       | a master of many charts: periodic and multi-patch B-splines, subdivision faces, facets on any quad surface |
 //!
 //! ## Notation (paper symbol ↔ Rust name ↔ equation)
 //! | paper | Rust | eq. |
@@ -32,16 +34,19 @@
 //! Control points are stored `i + na * j` with `i` along direction 1 (ξ¹) and `j`
 //! along direction 2 (ξ²). The parameter domain is `[0, 1]²`.
 
+pub mod atlas;
 pub mod basis;
 pub mod facet;
 pub mod knots;
 pub mod patch;
 pub mod projection;
 pub mod span_tree;
+pub mod subdivision;
 
 #[cfg(test)]
 mod fd;
 
+pub use atlas::{Atlas, AtlasProjector, EdgeKind};
 pub use facet::{FacetProjector, FacetSurface};
 pub use knots::KnotVector;
 pub use patch::{BSplinePatch, SurfaceBasis, SurfacePoint};
@@ -71,4 +76,8 @@ pub enum SplineError {
     ControlNetSize { got: usize, na: usize, nb: usize, expected: usize },
     #[error("control point {index} is not finite: {point:?}")]
     NonFiniteControlPoint { index: usize, point: [f64; 3] },
+    #[error("{what} is not available in this build")]
+    Unsupported { what: String },
+    #[error("Catmull–Clark master: {message}")]
+    Subdivision { message: String },
 }

@@ -68,6 +68,20 @@ impl SurfaceBasis {
         &self.q_alpha_beta[..self.len]
     }
 
+    /// Renumber the control points (`node → map(node)`) and rescale the derivatives
+    /// to a parameter `ξ_patch = lo + h ξ_local` (Q_{,α} ·= h_α, Q_{,αβ} ·= h_α h_β).
+    pub(crate) fn remap_scale(&mut self, map: impl Fn(usize) -> usize, h: [f64; 2]) {
+        for l in 0..self.len {
+            self.nodes[l] = map(self.nodes[l]);
+            for al in 0..2 {
+                self.q_alpha[l][al] *= h[al];
+                for be in 0..2 {
+                    self.q_alpha_beta[l][al][be] *= h[al] * h[be];
+                }
+            }
+        }
+    }
+
     pub(crate) fn clear(&mut self) {
         self.len = 0;
     }
@@ -186,6 +200,12 @@ impl BSplinePatch {
         Ok(Self { knots: [KnotVector::open_uniform(na, ka)?, KnotVector::open_uniform(nb, kb)?] })
     }
 
+    /// A patch on given knot vectors (e.g. a periodic direction, see
+    /// [`KnotVector::periodic_uniform`]); its control net has `kv_a.n() × kv_b.n()` points.
+    pub fn with_knots(kv_a: KnotVector, kv_b: KnotVector) -> Self {
+        Self { knots: [kv_a, kv_b] }
+    }
+
     /// Control points per direction `[na, nb]`.
     pub fn n_ctrl(&self) -> [usize; 2] {
         [self.knots[0].n(), self.knots[1].n()]
@@ -256,8 +276,13 @@ impl BSplinePatch {
 
     /// Position and first and second derivatives at ξ (for Newton).
     pub fn jet(&self, x: &[Vec3], xi: [f64; 2]) -> Jet {
+        self.jet_in_span(x, xi, self.span_of(xi))
+    }
+
+    /// [`Self::jet`] of span `[sa, sb]`'s polynomial (continued beyond the span when
+    /// ξ lies outside it).
+    pub fn jet_in_span(&self, x: &[Vec3], xi: [f64; 2], [sa, sb]: [usize; 2]) -> Jet {
         self.assert_net(x);
-        let [sa, sb] = self.span_of(xi);
         let [ka, kb] = self.orders();
         let na = self.knots[0].n();
         let mut Da: BasisDers = [[0.0; MAX_ORDER]; 4];
@@ -297,8 +322,13 @@ impl BSplinePatch {
     /// [`Self::evaluate`] into a caller's buffer.
     #[allow(clippy::needless_range_loop)] // r, t, i, j are the math indices of Q = N_r M_t
     pub fn evaluate_into(&self, x: &[Vec3], xi: [f64; 2], out: &mut SurfacePoint) {
+        self.evaluate_in_span_into(x, xi, self.span_of(xi), out)
+    }
+
+    /// [`Self::evaluate_into`] with span `[sa, sb]`'s polynomial.
+    #[allow(clippy::needless_range_loop)]
+    pub fn evaluate_in_span_into(&self, x: &[Vec3], xi: [f64; 2], [sa, sb]: [usize; 2], out: &mut SurfacePoint) {
         self.assert_net(x);
-        let [sa, sb] = self.span_of(xi);
         let [ka, kb] = self.orders();
         let na = self.knots[0].n();
         let mut Da: BasisDers = [[0.0; MAX_ORDER]; 4];

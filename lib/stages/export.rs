@@ -8,6 +8,7 @@ use crate::format::scres::Results;
 use crate::format::sccontact::{ContactModel, ContactPair, MasterKind};
 use crate::format::{sccontact, scmesh, scres, vtk};
 use crate::spline::{BSplinePatch, FacetSurface, SurfacePoint, Vec3};
+use crate::contact::master::Projector;
 use crate::post::stresses;
 
 /// Output formats of `sc-export`.
@@ -300,7 +301,8 @@ pub fn write_contact_vtu(model: &ContactModel, output: &Path) -> Result<String, 
 /// or facet. Each span gets its own points, so the facets' normals stay per facet.
 pub fn master_surface_grid(p: &ContactPair, x: &[Vec3]) -> Result<vtk::Grid, StageRunError> {
     let bad = |e: crate::spline::SplineError| StageRunError::Usage(format!("pair '{}': {e}", p.name));
-    let (a, b) = (p.net.a, p.net.b);
+    let Some(grid) = p.net.grid() else { return atlas_surface_grid(p, x) };
+    let (a, b) = (grid.a, grid.b);
     enum Master {
         Bspline(BSplinePatch),
         Facet(FacetSurface),
@@ -316,6 +318,7 @@ pub fn master_surface_grid(p: &ContactPair, x: &[Vec3]) -> Result<vtk::Grid, Sta
             f.check_control_net(x).map_err(bad)?;
             Master::Facet(f)
         }
+        other => return Err(StageRunError::Usage(format!("pair '{}': a {} master on one grid", p.name, other.name()))),
     };
     let spans = match &master {
         Master::Bspline(patch) => patch.n_spans(),
@@ -357,11 +360,65 @@ pub fn master_surface_grid(p: &ContactPair, x: &[Vec3]) -> Result<vtk::Grid, Sta
     Ok(g)
 }
 
+/// A master of many charts (closed, multi-patch, free quads): [`SUBDIVISIONS`]² quads
+/// per chart, each chart with its own points; point data `normal` and the chart
+/// parameter `xi`, cell data `chart`.
+fn atlas_surface_grid(p: &ContactPair, x: &[Vec3]) -> Result<vtk::Grid, StageRunError> {
+    let projector = Projector::for_net(p.master_kind, p.orders, &p.net, x).map_err(|e| StageRunError::Usage(format!("pair '{}': {e}", p.name)))?;
+    let Projector::Atlas(atlas) = &projector else {
+        return Err(StageRunError::Usage(format!("pair '{}': a one-grid master reached the atlas export", p.name)));
+    };
+    let s = SUBDIVISIONS;
+    let mut g = vtk::Grid::default();
+    let (mut normal, mut xis, mut charts) = (Vec::new(), Vec::new(), Vec::new());
+    for c in 0..atlas.atlas().n_charts() {
+        let base = g.points.len() as u32;
+        for v in 0..=s {
+            for u in 0..=s {
+                let uv = [u as f64 / s as f64, v as f64 / s as f64];
+                let sp = atlas.evaluate(c, uv);
+                g.points.push([sp.x_bar.x, sp.x_bar.y, sp.x_bar.z]);
+                normal.extend([sp.n_bar.x, sp.n_bar.y, sp.n_bar.z]);
+                xis.extend([uv[0], uv[1], 0.0]);
+            }
+        }
+        let id = |u: usize, v: usize| base + (u + (s + 1) * v) as u32;
+        for v in 0..s {
+            for u in 0..s {
+                g.push_cell(vtk::CellKind::Quad, &[id(u, v), id(u + 1, v), id(u + 1, v + 1), id(u, v + 1)]);
+                charts.push(c as i32);
+            }
+        }
+    }
+    g.point_data.push(vtk::Field::vector_f64("normal", normal));
+    g.point_data.push(vtk::Field::vector_f64("xi", xis));
+    g.cell_data.push(vtk::Field { name: "chart".into(), components: 1, values: vtk::FieldValues::I32(charts) });
+    Ok(g)
+}
+
 /// The control net as VTK lines: rows (along ξ¹) and columns (along ξ²) through the
 /// net's nodes (the current coordinates `x`, in net order); point data
-/// `gmsh_node_tag` and the grid position `i`, `j`.
+/// `gmsh_node_tag` and the grid position `i`, `j`. Other nets: the edges of their
+/// cells, point data `gmsh_node_tag` and the node's position `k` in the net.
 pub fn control_net_grid(p: &ContactPair, x: &[Vec3], mesh: &crate::mesh::Mesh) -> vtk::Grid {
-    let (a, b) = (p.net.a, p.net.b);
+    let tags = vtk::Field {
+        name: "gmsh_node_tag".into(),
+        components: 1,
+        values: vtk::FieldValues::I64(p.net.nodes.iter().map(|&n| mesh.node_tags[n as usize] as i64).collect()),
+    };
+    let Some(grid) = p.net.grid() else {
+        let mut g = vtk::Grid { points: x.iter().map(|v| [v.x, v.y, v.z]).collect(), ..Default::default() };
+        let mut edges: Vec<(u32, u32)> = p.net.cells().iter().flat_map(|q| (0..4).map(move |c| (q[c].min(q[(c + 1) % 4]), q[c].max(q[(c + 1) % 4])))).collect();
+        edges.sort_unstable();
+        edges.dedup();
+        for (u, v) in edges {
+            g.push_cell(vtk::CellKind::Line, &[u, v]);
+        }
+        g.point_data.push(tags);
+        g.point_data.push(vtk::Field { name: "k".into(), components: 1, values: vtk::FieldValues::I32((0..x.len() as i32).collect()) });
+        return g;
+    };
+    let (a, b) = (grid.a, grid.b);
     let mut g = vtk::Grid { points: x.iter().map(|v| [v.x, v.y, v.z]).collect(), ..Default::default() };
     let id = |i: usize, j: usize| (i + a * j) as u32;
     for j in 0..b {
@@ -374,11 +431,7 @@ pub fn control_net_grid(p: &ContactPair, x: &[Vec3], mesh: &crate::mesh::Mesh) -
             g.push_cell(vtk::CellKind::Line, &[id(i, j), id(i, j + 1)]);
         }
     }
-    g.point_data.push(vtk::Field {
-        name: "gmsh_node_tag".into(),
-        components: 1,
-        values: vtk::FieldValues::I64(p.net.nodes.iter().map(|&n| mesh.node_tags[n as usize] as i64).collect()),
-    });
+    g.point_data.push(tags);
     g.point_data.push(vtk::Field { name: "i".into(), components: 1, values: vtk::FieldValues::I32((0..a * b).map(|k| (k % a) as i32).collect()) });
     g.point_data.push(vtk::Field { name: "j".into(), components: 1, values: vtk::FieldValues::I32((0..a * b).map(|k| (k / a) as i32).collect()) });
     g

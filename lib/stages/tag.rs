@@ -2,17 +2,22 @@
 //! (`.sccontact`).
 //!
 //! For each pair the slave set (node set, or face set through its nodes) gives the
-//! slave nodes, and the master face set is ordered into the a × b control net of
-//! [`crate::contact::net`]; the orders are checked against the net with the spline
-//! library (order k needs at least k control points per row) and the open uniform
-//! knot vectors (eq. 5.1) are stored beside the net.
+//! slave nodes, and the master face set is ordered into a control net
+//! ([`crate::contact::net`]). A `bspline` master takes the first that fits of:
+//! one grid (the paper's patch, open knots), a grid closed on itself (periodic
+//! knots along ξ¹), several grids (one patch each), and — for any other manifold
+//! quad surface — the Catmull–Clark limit surface (`subdivision`). `patch`,
+//! `periodic`, `multipatch` and `subdivision` force one of them; `facet` takes one
+//! grid when the set is one, any quad surface otherwise. The orders are checked
+//! against every grid (order k needs at least k control points per row) and the knot
+//! vectors (eq. 5.1) are stored beside the net.
 
 use std::path::Path;
 
 use serde::Deserialize;
 
 use super::StageRunError;
-use crate::contact::{control_net, NetError};
+use crate::contact::{master_net, MasterNet, NetChoice, NetError, NetShape};
 use crate::format::scmesh;
 use crate::format::sccontact::{ContactModel, ContactPair, MasterKind, SlaveKind};
 use crate::mesh::Mesh;
@@ -23,7 +28,8 @@ use crate::spline::SplineError;
 pub const DEFAULT_ORDERS: [usize; 2] = [3, 3];
 
 /// One pair as the user gives it (pipeline `tag.pairs` entry, `--pairs` file,
-/// or `--pair NAME:SLAVE:MASTER[:bspline:KA:KB|:facet]`).
+/// or `--pair NAME:SLAVE:MASTER[:KIND[:KA:KB]]`, KIND one of bspline, patch,
+/// periodic, multipatch, subdivision, facet).
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PairSpec {
@@ -34,7 +40,8 @@ pub struct PairSpec {
     pub master: String,
     #[serde(default)]
     pub master_kind: MasterKind,
-    /// [ka, kb]; default [3, 3] for `bspline`; must be [2, 2] (or absent) for `facet`.
+    /// [ka, kb]; default [3, 3] for the B-spline kinds; must be [2, 2] (or absent)
+    /// for `facet` and [4, 4] (or absent) for `subdivision`.
     #[serde(default)]
     pub orders: Option<[usize; 2]>,
 }
@@ -49,7 +56,7 @@ pub struct PairsFile {
 /// Why a pair could not be built.
 #[derive(Debug, thiserror::Error)]
 pub enum TagError {
-    #[error("--pair {given:?}: {why} (expected NAME:SLAVE:MASTER, NAME:SLAVE:MASTER:bspline:KA:KB or NAME:SLAVE:MASTER:facet)")]
+    #[error("--pair {given:?}: {why} (expected NAME:SLAVE:MASTER, NAME:SLAVE:MASTER:KIND or NAME:SLAVE:MASTER:KIND:KA:KB with KIND bspline, patch, periodic, multipatch, subdivision or facet)")]
     PairSyntax { given: String, why: String },
     #[error("{path}: {message}")]
     PairsFile { path: String, message: String },
@@ -61,10 +68,16 @@ pub enum TagError {
     UnknownSlave { pair: String, slave: String, node_sets: String, face_sets: String },
     #[error("pair '{pair}': master {source}")]
     Master { pair: String, source: NetError },
-    #[error("pair '{pair}': master '{master}' is a {a} × {b} node net, direction {direction}: {source}")]
-    Orders { pair: String, master: String, a: usize, b: usize, direction: usize, source: SplineError },
+    #[error("pair '{pair}': master '{master}' is a {net}: {source}")]
+    Orders { pair: String, master: String, net: String, source: SplineError },
     #[error("pair '{pair}': a facet master is bilinear (orders [2, 2]); orders {orders:?} were given")]
     FacetOrders { pair: String, orders: [usize; 2] },
+    #[error("pair '{pair}': a subdivision master is bicubic where regular (orders [4, 4]); orders {orders:?} were given")]
+    SubdivisionOrders { pair: String, orders: [usize; 2] },
+    #[error("pair '{pair}': master face set '{master}' cannot carry a Catmull–Clark surface: {why}")]
+    Subdivision { pair: String, master: String, why: String },
+    #[error("pair '{pair}': master face set '{master}' has no smooth master (a `facet` master takes any quad set):\n  one grid: {grid}\n  several grids: {patches}\n  subdivision: {subdivision}")]
+    NoSmoothMaster { pair: String, master: String, grid: String, patches: String, subdivision: String },
 }
 
 impl PairSpec {
@@ -75,16 +88,22 @@ impl PairSpec {
         if parts.len() < 3 || parts[..3].iter().any(|p| p.is_empty()) {
             return Err(err("a name, a slave set and a master face set are needed"));
         }
+        let kind_of = |k: &str| -> Option<MasterKind> {
+            [MasterKind::Bspline, MasterKind::Patch, MasterKind::Periodic, MasterKind::Multipatch, MasterKind::Subdivision, MasterKind::Facet].into_iter().find(|m| m.name() == k)
+        };
         let (master_kind, orders) = match &parts[3..] {
             [] => (MasterKind::Bspline, None),
-            ["facet"] => (MasterKind::Facet, None),
-            ["bspline", ka, kb] => {
+            [kind] => (kind_of(kind).ok_or_else(|| err(&format!("unknown master kind {kind:?}")))?, None),
+            [kind, ka, kb] => {
+                let m = kind_of(kind).ok_or_else(|| err(&format!("unknown master kind {kind:?}")))?;
+                if matches!(m, MasterKind::Facet | MasterKind::Subdivision) {
+                    return Err(err(&format!("a {} master has fixed orders; give none", m.name())));
+                }
                 let k = |v: &str| v.parse::<usize>().map_err(|_| err(&format!("order {v:?} is not a whole number")));
-                (MasterKind::Bspline, Some([k(ka)?, k(kb)?]))
+                (m, Some([k(ka)?, k(kb)?]))
             }
-            ["bspline"] => (MasterKind::Bspline, None),
-            [kind, ..] if *kind != "bspline" && *kind != "facet" => return Err(err(&format!("unknown master kind {kind:?}"))),
-            _ => return Err(err("a bspline master takes two orders KA:KB, a facet master none")),
+            [kind, ..] if kind_of(kind).is_none() => return Err(err(&format!("unknown master kind {kind:?}"))),
+            _ => return Err(err("a B-spline master takes two orders KA:KB, a facet or subdivision master none")),
         };
         Ok(Self { name: parts[0].into(), slave: parts[1].into(), master: parts[2].into(), master_kind, orders })
     }
@@ -116,18 +135,95 @@ pub fn build_pair(mesh: &Mesh, spec: &PairSpec) -> Result<ContactPair, TagError>
             face_sets: mesh.face_set_names().join(", "),
         });
     };
-    let net = control_net(mesh, &spec.master).map_err(|source| TagError::Master { pair: pair.clone(), source })?;
-    let orders = match (spec.master_kind, spec.orders) {
-        (MasterKind::Bspline, o) => o.unwrap_or(DEFAULT_ORDERS),
-        (MasterKind::Facet, None | Some([2, 2])) => [2, 2],
-        (MasterKind::Facet, Some(o)) => return Err(TagError::FacetOrders { pair, orders: o }),
+    let master_err = |source| TagError::Master { pair: pair.clone(), source };
+    let net_of = |choice| master_net(mesh, &spec.master, choice).map_err(master_err);
+    let bspline_orders = spec.orders.unwrap_or(DEFAULT_ORDERS);
+    let make = |master_kind: MasterKind, orders: [usize; 2], net: MasterNet| ContactPair {
+        name: pair.clone(),
+        slave_kind,
+        slave: spec.slave.clone(),
+        master: spec.master.clone(),
+        master_kind,
+        orders,
+        slave_nodes: slave_nodes.clone(),
+        net,
     };
-    let p = ContactPair { name: pair.clone(), slave_kind, slave: spec.slave.clone(), master: spec.master.clone(), master_kind: spec.master_kind, orders, slave_nodes, net };
-    for (d, (n, k)) in [(p.net.a, orders[0]), (p.net.b, orders[1])].into_iter().enumerate() {
-        crate::spline::KnotVector::open_uniform(n, k)
-            .map_err(|source| TagError::Orders { pair: pair.clone(), master: spec.master.clone(), a: p.net.a, b: p.net.b, direction: d + 1, source })?;
+    let check = |p: ContactPair| -> Result<ContactPair, TagError> {
+        p.check_orders().map_err(|source| TagError::Orders { pair: pair.clone(), master: spec.master.clone(), net: p.net.describe(), source })?;
+        Ok(p)
+    };
+    match spec.master_kind {
+        MasterKind::Facet => {
+            if let Some(o) = spec.orders.filter(|&o| o != [2, 2]) {
+                return Err(TagError::FacetOrders { pair, orders: o });
+            }
+            // one grid keeps the grid's facets; anything else is a free quad set
+            let net = match master_net(mesh, &spec.master, NetChoice::Grid) {
+                Ok(net) => net,
+                Err(_) => net_of(NetChoice::Quads)?,
+            };
+            check(make(MasterKind::Facet, [2, 2], net))
+        }
+        MasterKind::Subdivision => {
+            if let Some(o) = spec.orders.filter(|&o| o != [4, 4]) {
+                return Err(TagError::SubdivisionOrders { pair, orders: o });
+            }
+            let net = net_of(NetChoice::Quads)?;
+            subdivision_check(mesh, &spec.master, &net).map_err(|why| TagError::Subdivision { pair: pair.clone(), master: spec.master.clone(), why })?;
+            check(make(MasterKind::Subdivision, [4, 4], net))
+        }
+        MasterKind::Patch => check(make(MasterKind::Bspline, bspline_orders, net_of(NetChoice::Grid)?)),
+        MasterKind::Periodic => check(make(MasterKind::Bspline, bspline_orders, net_of(NetChoice::Periodic)?)),
+        MasterKind::Multipatch => check(make(MasterKind::Bspline, bspline_orders, net_of(NetChoice::Patches)?)),
+        MasterKind::Bspline => {
+            // one grid, a closed grid, several grids, any quad surface: the first that fits
+            let grid = match master_net(mesh, &spec.master, NetChoice::Grid) {
+                Ok(net) => return check(make(MasterKind::Bspline, bspline_orders, net)),
+                Err(e @ (NetError::UnknownFaceSet { .. } | NetError::Empty { .. } | NetError::SpansTwoBodies { .. } | NetError::Branch { .. } | NetError::Degenerate { .. })) => return Err(master_err(e)),
+                Err(e) => e.to_string(),
+            };
+            if let Ok(net) = master_net(mesh, &spec.master, NetChoice::Periodic) {
+                return check(make(MasterKind::Bspline, bspline_orders, net));
+            }
+            let patches = match master_net(mesh, &spec.master, NetChoice::Patches) {
+                Ok(net) => {
+                    let p = make(MasterKind::Bspline, bspline_orders, net);
+                    match p.check_orders() {
+                        Ok(()) => return Ok(p),
+                        Err(e) => format!("it splits into {}, too small for orders {bspline_orders:?}: {e}", p.net.describe()),
+                    }
+                }
+                Err(e) => e.to_string(),
+            };
+            let net = net_of(NetChoice::Quads)?;
+            match subdivision_check(mesh, &spec.master, &net) {
+                Ok(()) => Ok(make(MasterKind::Subdivision, [4, 4], net)),
+                Err(subdivision) => Err(TagError::NoSmoothMaster { pair, master: spec.master.clone(), grid, patches, subdivision }),
+            }
+        }
     }
-    Ok(p)
+}
+
+/// Whether the Catmull–Clark surface can be built on `net` (its boundary nodes in at
+/// most 2 faces, valences 3–14), the culprit named by gmsh tags.
+fn subdivision_check(mesh: &Mesh, master: &str, net: &MasterNet) -> Result<(), String> {
+    use crate::spline::subdivision::SubdivisionError as E;
+    let Err(e) = crate::spline::Atlas::subdivision(net.nodes.len(), net.cells()) else { return Ok(()) };
+    let node = |k: u32| net.nodes.get(k as usize).and_then(|&n| mesh.node_tags.get(n as usize)).copied().unwrap_or(k as u64);
+    let face = |f: usize| {
+        let set = mesh.face_set(master);
+        let quad = set.and_then(|s| s.quad_tags.get(f)).copied().unwrap_or(f as u64);
+        format!("quad {quad}")
+    };
+    Err(match e {
+        E::UnsupportedBoundaryNode { node: k, faces } => format!("boundary node {} (gmsh tag) lies in {faces} faces: concave corners and extraordinary boundary nodes are not supported (boundary nodes must lie in 1 or 2 faces)", node(k)),
+        E::ValenceTooLow { node: k, valence } => format!("interior node {} (gmsh tag) has valence {valence}; Catmull–Clark needs at least 3", node(k)),
+        E::ValenceTooHigh { node: k, valence, max } => format!("interior node {} (gmsh tag) has valence {valence}, above the supported {max}", node(k)),
+        E::NonManifoldVertex { node: k, .. } => format!("the faces around node {} (gmsh tag) do not form one fan", node(k)),
+        E::SupportTooLarge { face: f, nodes, max } => format!("{} depends on {nodes} nodes, more than {max}", face(f)),
+        E::StencilIncomplete { face: f } => format!("the faces around the corners of {} do not form a Catmull–Clark stencil (a mesh too small or folded there)", face(f)),
+        other => other.to_string(),
+    })
 }
 
 /// Build every pair (names unique, at least one pair).
@@ -161,7 +257,7 @@ pub fn summary(model: &ContactModel) -> Vec<String> {
         .iter()
         .map(|p| {
             format!(
-                "pair {}: {} slave nodes ({} '{}') against master '{}', {} × {} control net, {} orders [{}, {}]",
+                "pair {}: {} slave nodes ({} '{}') against master '{}', {}, {} orders [{}, {}]",
                 p.name,
                 p.slave_nodes.len(),
                 match p.slave_kind {
@@ -170,9 +266,12 @@ pub fn summary(model: &ContactModel) -> Vec<String> {
                 },
                 p.slave,
                 p.master,
-                p.net.a,
-                p.net.b,
-                p.master_kind.name(),
+                p.net.describe(),
+                match (&p.net.shape, p.master_kind) {
+                    (NetShape::Periodic { .. }, MasterKind::Bspline) => "periodic bspline",
+                    (NetShape::Patches(_), MasterKind::Bspline) => "multipatch bspline",
+                    (_, k) => k.name(),
+                },
                 p.orders[0],
                 p.orders[1]
             )
@@ -191,7 +290,9 @@ mod tests {
         let p = PairSpec::parse("c:up:low:bspline:4:2").unwrap();
         assert_eq!(p.orders, Some([4, 2]));
         assert_eq!(PairSpec::parse("c:up:low:facet").unwrap().master_kind, MasterKind::Facet);
-        for bad in ["c:up", "c::low", "c:up:low:nurbs", "c:up:low:bspline:3", "c:up:low:bspline:x:3", "c:up:low:facet:2:2"] {
+        assert_eq!(PairSpec::parse("c:up:low:periodic:4:3").unwrap().master_kind, MasterKind::Periodic);
+        assert_eq!(PairSpec::parse("c:up:low:subdivision").unwrap().master_kind, MasterKind::Subdivision);
+        for bad in ["c:up", "c::low", "c:up:low:nurbs", "c:up:low:bspline:3", "c:up:low:bspline:x:3", "c:up:low:facet:2:2", "c:up:low:subdivision:4:4"] {
             assert!(matches!(PairSpec::parse(bad), Err(TagError::PairSyntax { .. })), "{bad}");
         }
     }

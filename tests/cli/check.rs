@@ -34,7 +34,7 @@ fn write_model(dir: &Path, mesh: &Mesh, master: &str, flip: bool) {
     let mut model = build_model(mesh.clone(), "test", &[spec]).unwrap_or_else(|e| panic!("tag: {e}"));
     if flip {
         let net = &mut model.pairs[0].net;
-        let (a, b) = (net.a, net.b);
+        let [a, b] = net.dims().unwrap();
         let old = net.nodes.clone();
         for j in 0..b {
             for i in 0..a {

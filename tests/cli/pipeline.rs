@@ -32,7 +32,7 @@ fn parisch_pipeline_imports_and_exports() {
     let err = stderr(&o);
     assert!(o.status.success(), "{err}");
     assert!(err.contains("[1/7] import") && err.contains("[2/7] tag") && err.contains("[3/7] check") && err.contains("[4/7] solve") && err.contains("[7/7] export") && err.contains("pipeline finished"), "{err}");
-    assert!(err.contains("pair contact: 9 slave nodes (face set 'upper_bottom') against master 'lower_top', 4 × 4 control net, bspline orders [3, 3]"), "{err}");
+    assert!(err.contains("pair contact: 9 slave nodes (face set 'upper_bottom') against master 'lower_top', 4 × 4 grid, bspline orders [3, 3]"), "{err}");
     for f in ["parisch_contact.vtu", "parisch_contact_contact_surface.vtu", "parisch_contact_contact_net.vtu"] {
         assert!(dir.path().join("pipelines/out").join(f).is_file(), "{f} missing");
     }

@@ -39,7 +39,7 @@ fn tag(dir: &Path, mesh: &Path, pairs: &[&str]) -> (std::process::Output, PathBu
 /// n̄ of the B-spline patch at ξ̄ over the pair's net.
 fn normal_at(model: &ContactModel, pair: usize, xi: [f64; 2]) -> Vec3 {
     let p = &model.pairs[pair];
-    let patch = BSplinePatch::new(p.net.a, p.net.b, p.orders[0], p.orders[1]).unwrap();
+    let patch = BSplinePatch::new(p.net.grid().unwrap().a, p.net.grid().unwrap().b, p.orders[0], p.orders[1]).unwrap();
     let x: Vec<Vec3> = p.net.nodes.iter().map(|&n| Vec3::from(model.mesh.nodes[n as usize])).collect();
     patch.evaluate(&x, xi).n_bar
 }
@@ -52,7 +52,7 @@ fn parisch_master_is_a_4x4_net_facing_up() {
     assert!(o.status.success(), "{}", stderr(&o));
     let m = ContactModel::read(&out).unwrap();
     let p = &m.pairs[0];
-    assert_eq!((p.net.a, p.net.b, p.orders, p.master_kind, p.slave_kind), (4, 4, [3, 3], MasterKind::Bspline, SlaveKind::FaceSet));
+    assert_eq!((p.net.grid().unwrap().a, p.net.grid().unwrap().b, p.orders, p.master_kind, p.slave_kind), (4, 4, [3, 3], MasterKind::Bspline, SlaveKind::FaceSet));
     assert_eq!(p.slave_nodes.len(), 9);
     let lower = m.mesh.body("lower").unwrap() as u32;
     for (k, &n) in p.net.nodes.iter().enumerate() {
@@ -61,11 +61,11 @@ fn parisch_master_is_a_4x4_net_facing_up() {
         // Grid order: neighbours in i and j are 10 mm apart along one axis.
         let (i, j) = (k % 4, k / 4);
         if i > 0 {
-            let y = m.mesh.nodes[p.net.at(i - 1, j) as usize];
+            let y = m.mesh.nodes[p.net.grid().unwrap().at(i - 1, j) as usize];
             assert!(((x[0] - y[0]).abs() + (x[1] - y[1]).abs() - 10.0).abs() < 1e-9);
         }
     }
-    assert!(m.mesh.hexes.iter().zip(&m.mesh.hex_body).any(|(h, &b)| b == lower && h.contains(&p.net.at(0, 0))));
+    assert!(m.mesh.hexes.iter().zip(&m.mesh.hex_body).any(|(h, &b)| b == lower && h.contains(&p.net.grid().unwrap().at(0, 0))));
     for xi in [[0.0, 0.0], [0.5, 0.5], [0.9, 0.2]] {
         let n = normal_at(&m, 0, xi);
         assert!((n.z - 1.0).abs() < 1e-12, "n̄ at {xi:?} = {n:?}: must point +z, out of the lower block");
@@ -84,7 +84,7 @@ fn block_faces_give_outward_nets_flipping_j_when_needed() {
     for (k, e) in expect.iter().enumerate() {
         let p = &m.pairs[k];
         let sizes = [(4, 3), (4, 3), (3, 5), (4, 5)];
-        assert_eq!((p.net.a * p.net.b), sizes[k].0 * sizes[k].1, "pair {}", p.name);
+        assert_eq!((p.net.nodes.len()), sizes[k].0 * sizes[k].1, "pair {}", p.name);
         let n = if p.master_kind == MasterKind::Facet {
             let mut q = p.clone();
             q.orders = [2, 2];
@@ -110,7 +110,7 @@ fn folded_face_set_is_a_grid() {
     let (o, out) = tag(dir.path(), &mesh, &["p:origin:fold:bspline:3:3"]);
     assert!(o.status.success(), "{}", stderr(&o));
     let m = ContactModel::read(&out).unwrap();
-    assert_eq!(m.pairs[0].net.a * m.pairs[0].net.b, 15);
+    assert_eq!(m.pairs[0].net.nodes.len(), 15);
 }
 
 /// A mesh of `block` with face set "m" = the z1 faces that pass `keep` (by hex index).
@@ -131,19 +131,37 @@ fn refused(mesh: &Mesh, pair: &str, needles: &[&str]) {
 
 #[test]
 fn hole_is_refused() {
-    // 3×3 top faces minus the centre one (hex 4).
-    refused(&block_with_top([3, 3, 1], |e| e != 4), "p:origin:m", &["pair 'p': master face set 'm' has a hole", "2 closed loops"]);
+    // 3×3 top faces minus the centre one (hex 4): no grid, pieces of one face each,
+    // and concave corners the subdivision surface does not take. Each reason is given.
+    let m = block_with_top([3, 3, 1], |e| e != 4);
+    refused(&m, "p:origin:m", &["pair 'p': master face set 'm' has no smooth master", "one grid: face set 'm' has a hole", "2 closed loops", "8 grids (2 × 2, ", "too small for orders [3, 3]", "subdivision: boundary node", "lies in 3 faces"]);
+    refused(&m, "p:origin:m:patch", &["pair 'p': master face set 'm' has a hole", "2 closed loops"]);
+    refused(&m, "p:origin:m:subdivision", &["cannot carry a Catmull–Clark surface: boundary node", "lies in 3 faces"]);
+    // facets take any quad set; bilinear B-spline patches fit the one-face pieces
+    let dir = tempdir();
+    let p = write_mesh(dir.path(), &m);
+    let (o, out) = tag(dir.path(), &p, &["f:origin:m:facet", "b:origin:m:bspline:2:2"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(e.contains("against master 'm', 8 quads on 16 nodes, facet orders [2, 2]") && e.contains("8 grids (2 × 2, 2 × 2, 2 × 2, 2 × 2, 2 × 2, 2 × 2, 2 × 2, 2 × 2), multipatch bspline orders [2, 2]"), "{e}");
+    assert_eq!(ContactModel::read(&out).unwrap().pairs.len(), 2);
 }
 
 #[test]
 fn l_shape_is_refused() {
     // 2×2 top faces minus hex 3's: the re-entrant corner is named with its faces.
-    refused(&block_with_top([2, 2, 1], |e| e != 3), "p:origin:m", &["non-rectangular outline", "re-entrant corner in 3 faces", "quad 501 (face 1 of hex 1)"]);
+    let m = block_with_top([2, 2, 1], |e| e != 3);
+    refused(&m, "p:origin:m:patch", &["non-rectangular outline", "re-entrant corner in 3 faces", "quad 501 (face 1 of hex 1)"]);
+    refused(&m, "p:origin:m", &["has no smooth master", "non-rectangular outline", "re-entrant corner in 3 faces", "subdivision: boundary node 14 (gmsh tag) lies in 3 faces"]);
 }
 
 #[test]
 fn faces_meeting_at_a_point_are_refused() {
-    refused(&block_with_top([2, 2, 1], |e| e == 0 || e == 3), "p:origin:m", &["non-rectangular outline", "4 boundary edges meet"]);
+    let m = block_with_top([2, 2, 1], |e| e == 0 || e == 3);
+    refused(&m, "p:origin:m:patch", &["non-rectangular outline", "4 boundary edges meet"]);
+    for kind in ["bspline", "facet", "subdivision"] {
+        refused(&m, &format!("p:origin:m:{kind}"), &["is not a manifold surface at node 14 (gmsh tag)", "quad 501 (face 1 of hex 1)", "quad 504 (face 1 of hex 4)"]);
+    }
 }
 
 #[test]
@@ -171,7 +189,7 @@ fn orders_too_high_for_the_net_are_refused() {
     let dir = tempdir();
     let mesh = parisch_scmesh(dir.path());
     let (o, out) = tag(dir.path(), &mesh, &["c:upper_bottom:lower_top:bspline:3:5"]);
-    assert_fails(&o, 2, &["pair 'c': master 'lower_top' is a 4 × 4 node net, direction 2", "a 4-node row cannot carry order 5"], &out);
+    assert_fails(&o, 2, &["pair 'c': master 'lower_top' is a 4 × 4 grid: a 4-node row cannot carry order 5"], &out);
     let (o, out) = tag(dir.path(), &mesh, &["c:upper_bottom:lower_top:bspline:3:7"]);
     assert_fails(&o, 2, &["order 7 exceeds the supported maximum 6"], &out);
     let (o, out) = tag(dir.path(), &mesh, &["c:upper_bottom:lower_top:bspline:1:3"]);

@@ -435,5 +435,7 @@ fn project_point(geometry: &Projector, trace: &FacetProjector, x: &Vec3, cell: [
             let t = on_cell(trace)?;
             Some((p.xi, t.xi, p.g))
         }
+        // a mortar pair needs a one-grid master (`PairError::MortarNeedsGrid`)
+        Projector::Atlas(_) => None,
     }
 }

@@ -1,0 +1,549 @@
+//! The master control net: how the nodes of a master face set become the control
+//! points of the master surface (paper sec. 5, eq. 5.2).
+//!
+//! The paper orders the master nodes into one structured a × b grid. Real masters
+//! are also closed (a tube), made of several grids (a box corner, an L) or free quad
+//! meshes with extraordinary nodes (a sphere). [`master_net`] reads which one a face
+//! set is and orders it:
+//!
+//! | shape | file | surface built on it |
+//! |-------|------|---------------------|
+//! | [`NetShape::Grid`] | [`grid`] | one B-spline patch, open knots (the paper), or bilinear facets |
+//! | [`NetShape::Periodic`] | [`periodic`] | one B-spline patch, periodic knots along ξ¹ |
+//! | [`NetShape::Patches`] | [`patches`] | one open B-spline patch per grid, C⁰ at the seams |
+//! | [`NetShape::Quads`] | [`surface`] | the Catmull–Clark limit surface, or bilinear facets |
+//!
+//! [`surface`] holds the checks every shape shares: one body, no branching edge, no
+//! collapsed face, one orientation. Every cell of every shape is listed so that the
+//! right-hand rule on its node cycle gives the normal out of the master body.
+
+mod grid;
+mod patches;
+mod periodic;
+mod surface;
+
+use crate::mesh::Mesh;
+use surface::Surface;
+
+/// One structured a × b grid of mesh nodes, `nodes[i + a·j]`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ControlNet {
+    /// Control points along ξ¹ (a) and ξ² (b).
+    pub a: usize,
+    pub b: usize,
+    /// Node indices, `nodes[i + a*j]`.
+    pub nodes: Vec<u32>,
+}
+
+impl ControlNet {
+    /// The node at grid position (i, j).
+    pub fn at(&self, i: usize, j: usize) -> u32 {
+        self.nodes[i + self.a * j]
+    }
+}
+
+/// One grid of a multi-patch master: `nodes[i + a·j]` are positions in
+/// [`MasterNet::nodes`].
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct PatchNet {
+    pub a: usize,
+    pub b: usize,
+    pub nodes: Vec<u32>,
+}
+
+/// How the master nodes are arranged.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum NetShape {
+    /// One a × b grid, `nodes[i + a·j]` (the paper's patch).
+    Grid { a: usize, b: usize },
+    /// One a × b grid closed along ξ¹: column a is column 0.
+    Periodic { a: usize, b: usize },
+    /// Several grids sharing the nodes on their seams.
+    Patches(Vec<PatchNet>),
+    /// Any manifold quad surface: faces as positions in [`MasterNet::nodes`].
+    Quads(Vec<[u32; 4]>),
+}
+
+/// The master nodes (mesh node indices, the control points) and their arrangement.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct MasterNet {
+    pub nodes: Vec<u32>,
+    pub shape: NetShape,
+}
+
+impl From<ControlNet> for MasterNet {
+    fn from(net: ControlNet) -> Self {
+        Self { shape: NetShape::Grid { a: net.a, b: net.b }, nodes: net.nodes }
+    }
+}
+
+impl MasterNet {
+    /// The single grid of a [`NetShape::Grid`] net.
+    pub fn grid(&self) -> Option<ControlNet> {
+        match self.shape {
+            NetShape::Grid { a, b } => Some(ControlNet { a, b, nodes: self.nodes.clone() }),
+            _ => None,
+        }
+    }
+
+    /// Grid dimensions [a, b] of a one-grid net (open or periodic).
+    pub fn dims(&self) -> Option<[usize; 2]> {
+        match self.shape {
+            NetShape::Grid { a, b } | NetShape::Periodic { a, b } => Some([a, b]),
+            _ => None,
+        }
+    }
+
+    /// Every cell of the net as positions in [`Self::nodes`], each cycle outward.
+    pub fn cells(&self) -> Vec<[u32; 4]> {
+        let grid_cells = |a: usize, b: usize, wrap: bool, map: &dyn Fn(usize) -> u32| -> Vec<[u32; 4]> {
+            let ni = if wrap { a } else { a - 1 };
+            let mut out = Vec::with_capacity(ni * (b - 1));
+            for j in 0..b - 1 {
+                for i in 0..ni {
+                    let i1 = (i + 1) % a;
+                    out.push([map(i + a * j), map(i1 + a * j), map(i1 + a * (j + 1)), map(i + a * (j + 1))]);
+                }
+            }
+            out
+        };
+        match &self.shape {
+            NetShape::Grid { a, b } => grid_cells(*a, *b, false, &|p| p as u32),
+            NetShape::Periodic { a, b } => grid_cells(*a, *b, true, &|p| p as u32),
+            NetShape::Patches(ps) => ps.iter().flat_map(|p| grid_cells(p.a, p.b, false, &|k| p.nodes[k])).collect(),
+            NetShape::Quads(f) => f.clone(),
+        }
+    }
+
+    /// "6 × 4 grid", "32 × 5 closed grid", "3 grids (4 × 4, 4 × 4, 4 × 4)", "118 quads".
+    pub fn describe(&self) -> String {
+        match &self.shape {
+            NetShape::Grid { a, b } => format!("{a} × {b} grid"),
+            NetShape::Periodic { a, b } => format!("{a} × {b} grid closed along ξ¹"),
+            NetShape::Patches(ps) => format!("{} grids ({})", ps.len(), ps.iter().map(|p| format!("{} × {}", p.a, p.b)).collect::<Vec<_>>().join(", ")),
+            NetShape::Quads(f) => format!("{} quads on {} nodes", f.len(), self.nodes.len()),
+        }
+    }
+}
+
+/// Which arrangement to build (sc-tag's per-pair choice).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum NetChoice {
+    /// One grid, else closed, else several grids, else any quad surface.
+    Auto,
+    Grid,
+    Periodic,
+    Patches,
+    Quads,
+}
+
+/// Why a face set cannot be a master control net. Faces are named by their gmsh
+/// quad tag and the hexahedron (gmsh element tag) they bound, nodes by gmsh tag.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum NetError {
+    #[error("face set '{set}' does not exist (face sets: {known})")]
+    UnknownFaceSet { set: String, known: String },
+    #[error("face set '{set}' is empty")]
+    Empty { set: String },
+    #[error("face set '{set}' spans two bodies: {face_a} is in body '{body_a}', {face_b} in body '{body_b}' (one master surface follows one body)")]
+    SpansTwoBodies { set: String, body_a: String, face_a: String, body_b: String, face_b: String },
+    #[error("face set '{set}' has a collapsed face: {face} repeats a node (a master face is a quad with 4 distinct nodes)")]
+    Degenerate { set: String, face: String },
+    #[error("face set '{set}' branches: the edge between nodes {n0} and {n1} (gmsh tags) is shared by {count} faces: {faces} (a surface edge bounds at most 2 faces)")]
+    Branch { set: String, n0: u64, n1: u64, count: usize, faces: String },
+    #[error("face set '{set}' is not a manifold surface at node {node} (gmsh tag): its faces {faces} touch only at that node")]
+    NonManifoldVertex { set: String, node: u64, faces: String },
+    #[error("face set '{set}' has a hole: its boundary is {loops} closed loops, not one (a rectangular patch has a single outline)")]
+    Hole { set: String, loops: usize },
+    #[error("face set '{set}' has a non-rectangular outline: {what}")]
+    NonRectangular { set: String, what: String },
+    #[error("face set '{set}' is not a regular grid: interior node {node} (gmsh tag) is in {count} faces, a structured grid has 4 ({faces})")]
+    IrregularInterior { set: String, node: u64, count: usize, faces: String },
+    #[error("face set '{set}' is not a structured grid: {what}")]
+    NotAGrid { set: String, what: String },
+    #[error("face set '{set}' is inconsistently oriented: {face} faces the other way from {other}")]
+    Orientation { set: String, face: String, other: String },
+    #[error("face set '{set}' is not a closed grid: {what}")]
+    NotPeriodic { set: String, what: String },
+    #[error("face set '{set}' does not split into rectangular grids: {what}")]
+    NotPatches { set: String, what: String },
+}
+
+/// Order the face set `name` of `mesh` into one structured grid ([`grid`]).
+pub fn control_net(mesh: &Mesh, name: &str) -> Result<ControlNet, NetError> {
+    grid::grid(&Surface::of_set(mesh, name)?)
+}
+
+/// Order the face set `name` as `choice` asks; `Auto` takes the first of one grid,
+/// a closed grid, several grids and any quad surface that fits, and says which.
+pub fn master_net(mesh: &Mesh, name: &str, choice: NetChoice) -> Result<MasterNet, NetError> {
+    let s = Surface::of_set(mesh, name)?;
+    match choice {
+        NetChoice::Grid => Ok(grid::grid(&s)?.into()),
+        NetChoice::Periodic => {
+            let net = periodic::periodic(&s)?;
+            Ok(MasterNet { shape: NetShape::Periodic { a: net.a, b: net.b }, nodes: net.nodes })
+        }
+        NetChoice::Patches => Ok(from_patches(patches::patches(&s)?)),
+        NetChoice::Quads => quads(&s),
+        NetChoice::Auto => {
+            if let Ok(net) = grid::grid(&s) {
+                return Ok(net.into());
+            }
+            if let Ok(net) = periodic::periodic(&s) {
+                return Ok(MasterNet { shape: NetShape::Periodic { a: net.a, b: net.b }, nodes: net.nodes });
+            }
+            if let Ok(ps) = patches::patches(&s) {
+                if ps.len() > 1 {
+                    return Ok(from_patches(ps));
+                }
+            }
+            quads(&s)
+        }
+    }
+}
+
+/// Several grids over one node list (first appearance order).
+fn from_patches(ps: Vec<ControlNet>) -> MasterNet {
+    let mut nodes: Vec<u32> = Vec::new();
+    let mut pos: std::collections::HashMap<u32, u32> = std::collections::HashMap::new();
+    let patches = ps
+        .into_iter()
+        .map(|net| {
+            let local = net
+                .nodes
+                .iter()
+                .map(|&n| {
+                    *pos.entry(n).or_insert_with(|| {
+                        nodes.push(n);
+                        nodes.len() as u32 - 1
+                    })
+                })
+                .collect();
+            PatchNet { a: net.a, b: net.b, nodes: local }
+        })
+        .collect();
+    MasterNet { nodes, shape: NetShape::Patches(patches) }
+}
+
+/// Any manifold, consistently oriented quad surface; nodes in first-appearance order.
+fn quads(s: &Surface) -> Result<MasterNet, NetError> {
+    s.check_orientation()?;
+    s.check_vertex_fans()?;
+    let mut nodes: Vec<u32> = Vec::new();
+    let mut pos: std::collections::HashMap<u32, u32> = std::collections::HashMap::new();
+    let faces = s
+        .quads
+        .iter()
+        .map(|q| {
+            q.map(|n| {
+                *pos.entry(n).or_insert_with(|| {
+                    nodes.push(n);
+                    nodes.len() as u32 - 1
+                })
+            })
+        })
+        .collect();
+    Ok(MasterNet { nodes, shape: NetShape::Quads(faces) })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::{Body, FaceSet, HexFace};
+
+    /// An nx × ny × 1 block of unit hexes, one body; every hex top face (local 1,
+    /// normal +z) whose (i, j) passes `keep` goes into face set "top", and the bottom
+    /// faces (local 0, normal −z) into "bottom".
+    fn slab(nx: usize, ny: usize, keep: impl Fn(usize, usize) -> bool) -> Mesh {
+        let id = |i: usize, j: usize, k: usize| (i + (nx + 1) * (j + (ny + 1) * k)) as u32;
+        let mut nodes = Vec::new();
+        for k in 0..2 {
+            for j in 0..=ny {
+                for i in 0..=nx {
+                    nodes.push([i as f64, j as f64, k as f64]);
+                }
+            }
+        }
+        let mut hexes = Vec::new();
+        let mut top = FaceSet { name: "top".into(), physical_tag: 1, faces: vec![], quad_tags: vec![] };
+        let mut bottom = FaceSet { name: "bottom".into(), physical_tag: 2, faces: vec![], quad_tags: vec![] };
+        for j in 0..ny {
+            for i in 0..nx {
+                let e = hexes.len() as u32;
+                hexes.push([id(i, j, 0), id(i + 1, j, 0), id(i + 1, j + 1, 0), id(i, j + 1, 0), id(i, j, 1), id(i + 1, j, 1), id(i + 1, j + 1, 1), id(i, j + 1, 1)]);
+                if keep(i, j) {
+                    top.faces.push(HexFace { element: e, local: 1 });
+                    top.quad_tags.push(1000 + e as u64);
+                    bottom.faces.push(HexFace { element: e, local: 0 });
+                    bottom.quad_tags.push(2000 + e as u64);
+                }
+            }
+        }
+        let m = hexes.len();
+        Mesh {
+            node_tags: (1..=nodes.len() as u64).collect(),
+            nodes,
+            hexes,
+            hex_body: vec![0; m],
+            bodies: vec![Body { name: "slab".into(), physical_tag: 1 }],
+            node_sets: vec![],
+            face_sets: vec![top, bottom],
+            element_tags: (101..101 + m as u64).collect(),
+        }
+    }
+
+    /// n̄ of the net's first cell, from the corner control points (ā_1 × ā_2 at ξ = 0).
+    fn corner_normal(mesh: &Mesh, net: &ControlNet) -> [f64; 3] {
+        let x = |n: u32| mesh.nodes[n as usize];
+        let (p, q, r) = (x(net.at(0, 0)), x(net.at(1, 0)), x(net.at(0, 1)));
+        let u = [q[0] - p[0], q[1] - p[1], q[2] - p[2]];
+        let v = [r[0] - p[0], r[1] - p[1], r[2] - p[2]];
+        [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]]
+    }
+
+    #[test]
+    fn structured_top_and_bottom_face_outward() {
+        let m = slab(3, 2, |_, _| true);
+        let top = control_net(&m, "top").unwrap();
+        assert_eq!((top.a * top.b, top.nodes.len()), (12, 12));
+        assert!(corner_normal(&m, &top)[2] > 0.0);
+        let bottom = control_net(&m, "bottom").unwrap();
+        assert!(corner_normal(&m, &bottom)[2] < 0.0, "bottom net must face −z");
+        // Every cell is a face of the set, and neighbours in the net are mesh neighbours.
+        for j in 0..top.b {
+            for i in 0..top.a - 1 {
+                let (p, q) = (m.nodes[top.at(i, j) as usize], m.nodes[top.at(i + 1, j) as usize]);
+                let d: f64 = (0..3).map(|c| (p[c] - q[c]).powi(2)).sum();
+                assert!((d - 1.0).abs() < 1e-12);
+            }
+        }
+    }
+
+    #[test]
+    fn hole_is_refused() {
+        let m = slab(3, 3, |i, j| !(i == 1 && j == 1));
+        let e = control_net(&m, "top").unwrap_err();
+        assert!(matches!(e, NetError::Hole { loops: 2, .. }), "{e}");
+        assert!(e.to_string().contains("has a hole"), "{e}");
+    }
+
+    #[test]
+    fn l_shape_is_refused() {
+        let m = slab(2, 2, |i, j| !(i == 1 && j == 1));
+        let e = control_net(&m, "top").unwrap_err().to_string();
+        assert!(e.contains("non-rectangular outline") && e.contains("re-entrant corner in 3 faces"), "{e}");
+        assert!(e.contains("quad 1000 (face 1 of hex 101)"), "{e}");
+    }
+
+    #[test]
+    fn faces_touching_at_a_corner_are_refused() {
+        let m = slab(2, 2, |i, j| i == j);
+        let e = control_net(&m, "top").unwrap_err().to_string();
+        assert!(e.contains("non-rectangular outline") && e.contains("4 boundary edges meet"), "{e}");
+    }
+
+    #[test]
+    fn branch_is_refused() {
+        // Top faces of a 2×1 slab plus the interior face between the two hexes
+        // (hex 0's local face 3, x = 1): three faces on the edge (1,0,1)–(1,1,1).
+        let mut m = slab(2, 1, |_, _| true);
+        m.face_sets[0].faces.push(HexFace { element: 0, local: 3 });
+        m.face_sets[0].quad_tags.push(77);
+        let e = control_net(&m, "top").unwrap_err().to_string();
+        assert!(e.contains("branches") && e.contains("3 faces") && e.contains("quad 77 (face 3 of hex 101)"), "{e}");
+    }
+
+    #[test]
+    fn two_bodies_are_refused() {
+        let mut m = slab(2, 1, |_, _| true);
+        m.bodies.push(Body { name: "other".into(), physical_tag: 2 });
+        m.hex_body[1] = 1;
+        let e = control_net(&m, "top").unwrap_err().to_string();
+        assert!(e.contains("spans two bodies") && e.contains("'slab'") && e.contains("'other'") && e.contains("hex 102"), "{e}");
+    }
+
+    #[test]
+    fn unknown_and_empty_sets() {
+        let mut m = slab(1, 1, |_, _| false);
+        let e = control_net(&m, "nope").unwrap_err().to_string();
+        assert!(e.contains("'nope' does not exist") && e.contains("top, bottom"), "{e}");
+        m.face_sets[0].faces.clear();
+        assert!(matches!(control_net(&m, "top"), Err(NetError::Empty { .. })));
+    }
+
+    #[test]
+    fn inconsistent_orientation_is_refused() {
+        // Hex 1 listed mirrored (nodes reversed within each layer): its local face 1
+        // is still on the top plane, but wound the other way from hex 0's.
+        let mut m = slab(2, 1, |_, _| true);
+        let h = m.hexes[1];
+        m.hexes[1] = [h[3], h[2], h[1], h[0], h[7], h[6], h[5], h[4]];
+        let e = control_net(&m, "top").unwrap_err().to_string();
+        assert!(e.contains("inconsistently oriented"), "{e}");
+    }
+
+    /// A surface of arbitrary quads: each quad is face 1 (nodes 4..8) of a stand-in
+    /// hexahedron (only the face topology matters to the net).
+    fn quad_surface(nodes: Vec<[f64; 3]>, quads: &[[u32; 4]]) -> Mesh {
+        let hexes: Vec<[u32; 8]> = quads.iter().map(|q| [q[0], q[1], q[2], q[3], q[0], q[1], q[2], q[3]]).collect();
+        let m = hexes.len();
+        Mesh {
+            node_tags: (1..=nodes.len() as u64).collect(),
+            nodes,
+            hexes,
+            hex_body: vec![0; m],
+            bodies: vec![Body { name: "b".into(), physical_tag: 1 }],
+            node_sets: vec![],
+            face_sets: vec![FaceSet {
+                name: "s".into(),
+                physical_tag: 1,
+                faces: (0..m as u32).map(|e| HexFace { element: e, local: 1 }).collect(),
+                quad_tags: (1..=m as u64).collect(),
+            }],
+            element_tags: (1..=m as u64).collect(),
+        }
+    }
+
+    #[test]
+    fn irregular_interior_is_refused() {
+        // A 2×2 square whose top-right quad is split into three around P: the outline
+        // is a rectangle with 4 corners, but P is in 3 faces and O in 5.
+        let nodes = vec![
+            [0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0], [2.0, 1.0, 0.0],
+            [0.0, 2.0, 0.0], [1.0, 2.0, 0.0], [2.0, 2.0, 0.0], [2.0, 1.5, 0.0], [1.5, 2.0, 0.0], [1.5, 1.5, 0.0],
+        ];
+        let quads = [[0, 1, 4, 3], [1, 2, 5, 4], [3, 4, 7, 6], [4, 5, 9, 11], [11, 9, 8, 10], [4, 11, 10, 7]];
+        let m = quad_surface(nodes, &quads);
+        let e = control_net(&m, "s").unwrap_err().to_string();
+        assert!(e.contains("not a regular grid: interior node 5 (gmsh tag) is in 5 faces"), "{e}");
+        // The regular 2×2 square on the same nodes is accepted.
+        let m = quad_surface(m.nodes.clone(), &[[0, 1, 4, 3], [1, 2, 5, 4], [3, 4, 7, 6], [4, 5, 8, 7]]);
+        let net = control_net(&m, "s").unwrap();
+        assert_eq!((net.a, net.b, net.nodes.clone()), (3, 3, (0..9).collect::<Vec<u32>>()));
+    }
+
+    /// Every cell of `net` is one of `quads` (mesh node ids) with the same cyclic order.
+    fn cells_match(net: &MasterNet, quads: &[[u32; 4]]) {
+        let cells = net.cells();
+        assert_eq!(cells.len(), quads.len());
+        for c in cells {
+            let m = c.map(|k| net.nodes[k as usize]);
+            let ok = quads.iter().any(|q| (0..4).any(|r| (0..4).all(|t| q[(t + r) % 4] == m[t])));
+            assert!(ok, "cell {m:?} is no face of the set in its orientation");
+        }
+    }
+
+    /// A tube: `na` nodes around, `nb` along z, quads outward.
+    fn tube(na: usize, nb: usize) -> (Mesh, Vec<[u32; 4]>) {
+        let mut nodes = Vec::new();
+        for j in 0..nb {
+            for i in 0..na {
+                let t = std::f64::consts::TAU * i as f64 / na as f64;
+                nodes.push([t.cos(), t.sin(), j as f64]);
+            }
+        }
+        let id = |i: usize, j: usize| (i % na + na * j) as u32;
+        let quads: Vec<[u32; 4]> = (0..nb - 1).flat_map(|j| (0..na).map(move |i| [id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)])).collect();
+        (quad_surface(nodes, &quads), quads)
+    }
+
+    #[test]
+    fn a_tube_is_a_closed_grid() {
+        let (m, quads) = tube(8, 4);
+        assert!(matches!(control_net(&m, "s"), Err(NetError::Hole { loops: 2, .. })));
+        let net = master_net(&m, "s", NetChoice::Auto).unwrap();
+        assert_eq!(net.shape, NetShape::Periodic { a: 8, b: 4 });
+        assert_eq!(net.describe(), "8 × 4 grid closed along ξ¹");
+        cells_match(&net, &quads);
+        // Reversed faces (an inward-listed tube) still give outward cells.
+        let rev: Vec<[u32; 4]> = quads.iter().map(|q| [q[0], q[3], q[2], q[1]]).collect();
+        let m = quad_surface(m.nodes.clone(), &rev);
+        let net = master_net(&m, "s", NetChoice::Periodic).unwrap();
+        cells_match(&net, &rev);
+        // A rectangle is not closed.
+        let m = slab(3, 2, |_, _| true);
+        let e = master_net(&m, "top", NetChoice::Periodic).unwrap_err().to_string();
+        assert!(e.contains("is not a closed grid: its boundary is 1 closed loops"), "{e}");
+    }
+
+    #[test]
+    fn an_l_is_three_grids() {
+        let m = slab(4, 4, |i, j| i < 2 || j < 2);
+        let quads: Vec<[u32; 4]> = m.face_sets[0].faces.iter().map(|&f| m.face_nodes(f)).collect();
+        let net = master_net(&m, "top", NetChoice::Auto).unwrap();
+        let NetShape::Patches(ps) = &net.shape else { panic!("{:?}", net.shape) };
+        // The re-entrant node (2,2) cuts along x = 2 and y = 2: 2×2, 2×2 and 2×2 cells.
+        let mut dims: Vec<[usize; 2]> = ps.iter().map(|p| [p.a, p.b]).collect();
+        dims.sort_unstable();
+        assert_eq!(dims, vec![[3, 3], [3, 3], [3, 3]]);
+        cells_match(&net, &quads);
+        assert_eq!(net.nodes.len(), 21);
+    }
+
+    /// Three faces of the cube [0, n]³ at the corner (n, n, n): x = n, y = n, z = n.
+    fn box_corner(n: usize) -> (Mesh, Vec<[u32; 4]>) {
+        let mut nodes: Vec<[f64; 3]> = Vec::new();
+        let mut index = std::collections::HashMap::new();
+        let mut id = |p: [usize; 3]| -> u32 {
+            *index.entry(p).or_insert_with(|| {
+                nodes.push(p.map(|c| c as f64));
+                nodes.len() as u32 - 1
+            })
+        };
+        let mut quads = Vec::new();
+        for (ax, (u, v)) in [(0usize, (1usize, 2usize)), (1, (2, 0)), (2, (0, 1))] {
+            for j in 0..n {
+                for i in 0..n {
+                    let at = |di: usize, dj: usize| {
+                        let mut p = [0; 3];
+                        p[ax] = n;
+                        p[u] = i + di;
+                        p[v] = j + dj;
+                        p
+                    };
+                    // (u, v, ax) is right-handed, so this cycle faces +ax (outward).
+                    quads.push([id(at(0, 0)), id(at(1, 0)), id(at(1, 1)), id(at(0, 1))]);
+                }
+            }
+        }
+        (quad_surface(nodes, &quads), quads)
+    }
+
+    #[test]
+    fn a_box_corner_is_three_grids() {
+        let (m, quads) = box_corner(3);
+        let net = master_net(&m, "s", NetChoice::Auto).unwrap();
+        assert_eq!(net.describe(), "3 grids (4 × 4, 4 × 4, 4 × 4)");
+        cells_match(&net, &quads);
+        assert_eq!(net.nodes.len(), 3 * 16 - 3 * 4 + 1);
+        // The same surface as quads.
+        let q = master_net(&m, "s", NetChoice::Quads).unwrap();
+        cells_match(&q, &quads);
+        assert!(master_net(&m, "s", NetChoice::Grid).is_err());
+    }
+
+    #[test]
+    fn quads_and_their_errors() {
+        // The split square of `irregular_interior_is_refused` is any-quad surface.
+        let nodes = vec![
+            [0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0], [2.0, 1.0, 0.0],
+            [0.0, 2.0, 0.0], [1.0, 2.0, 0.0], [2.0, 2.0, 0.0], [2.0, 1.5, 0.0], [1.5, 2.0, 0.0], [1.5, 1.5, 0.0],
+        ];
+        let quads = [[0, 1, 4, 3], [1, 2, 5, 4], [3, 4, 7, 6], [4, 5, 9, 11], [11, 9, 8, 10], [4, 11, 10, 7]];
+        let m = quad_surface(nodes.clone(), &quads);
+        let net = master_net(&m, "s", NetChoice::Quads).unwrap();
+        assert_eq!(net.describe(), "6 quads on 12 nodes");
+        cells_match(&net, &quads);
+        // Two faces touching at one node.
+        let m = slab(2, 2, |i, j| i == j);
+        let e = master_net(&m, "top", NetChoice::Quads).unwrap_err().to_string();
+        assert!(e.contains("not a manifold surface at node 14 (gmsh tag)") && e.contains("quad 1000"), "{e}");
+        // One face turned over.
+        let mut q2 = quads;
+        q2[5] = [4, 7, 10, 11];
+        let m = quad_surface(nodes, &q2);
+        let e = master_net(&m, "s", NetChoice::Quads).unwrap_err().to_string();
+        assert!(e.contains("inconsistently oriented") && e.contains("quad 6"), "{e}");
+    }
+}
