@@ -56,7 +56,6 @@ mod ffi;
 pub mod runtime;
 
 use std::ffi::{c_int, CString};
-use std::sync::Mutex;
 use std::time::Instant;
 
 use faer::sparse::SymbolicSparseColMatRef;
