@@ -6,16 +6,23 @@
 //! surface for contact surface smoothing*, Lat. Am. J. Solids Struct. 15(5).
 //!
 //! ## Crate map
+//! From the bottom layer up: a module imports only its own layer and those below
+//! (`tests/structure.rs` checks it, and that no files import each other in a circle).
+//!
 //! | module   | what it holds |
 //! |----------|---------------|
-//! | `format` | on-disk formats: stage container, `.scmesh`, gmsh MSH, VTK, pipeline YAML, the solver's CSV tables |
 //! | `mesh`   | the mesh: nodes, hex8, bodies, node and face sets, hex8 topology |
-//! | `contact` | contact pairs: a master face set ordered into the B-spline control net |
 //! | `spline` | the B-spline master patch and its bilinear-facet counterpart |
+//! | `folder_lock` | one pipeline at a time per output folder (a lock file naming its owner) |
+//! | `material`, `fem` | constitutive models; the hex8 element: shape functions, quadrature, kinematics, internal force and tangent |
+//! | `assembly` | dof numbering, the sparsity pattern built once, element scatter |
+//! | `contact` | contact pairs: settings, the control net, the node-to-surface and mortar elements, the pair during the solve |
+//! | `post`   | stresses and contact fields for output |
+//! | `format` | on-disk formats: stage container, `.scmesh`, `.sccontact`, results, gmsh MSH, VTK, setup and pipeline YAML, CSV tables |
+//! | `solver` | linear solvers, Newton, Uzawa, load stepping, restart |
 //! | `check`  | the pre-solve check: contact pairs at the start (projections, gaps, flipped masters, adjust), rigid-body modes |
 //! | `stages` | each pipeline stage as a library call (the binaries are thin wrappers) |
 //! | `pipeline` | the YAML pipeline runner |
-//! | `folder_lock` | one pipeline at a time per output folder (a lock file naming its owner) |
 //!
 //! ## Notation (paper symbol ↔ Rust name ↔ equation)
 //! | paper | Rust | eq. |

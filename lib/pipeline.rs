@@ -4,7 +4,8 @@
 use std::path::{Path, PathBuf};
 
 use crate::folder_lock::FolderLock;
-use crate::format::pipeline::{resolve, Pipeline, PipelineError, Stage};
+use crate::format::pipeline::{Pipeline, PipelineError, Stage};
+use crate::format::stage::files::resolve;
 use crate::format::setup::SolveSetup;
 use crate::solver::log::Verbosity;
 use crate::stages::{self, StageRunError};

@@ -741,7 +741,7 @@ def build_doc(results, meta, img_rel, facet):
                  "B-spline master (left or top), CalculiX with the contact option of the table (right or "
                  "bottom), one colour "
                  "scale per image. Both nodal stresses are the nodal average of the element averages of the "
-                 "Gauss-point Cauchy stresses (ccx's from a rerun of its deck with `*EL PRINT S`; its `.frd` "
+                 "Gauss-point Cauchy stresses (ccx's from a second run of its deck with `*EL PRINT S`; its `.frd` "
                  "values, extrapolated to the nodes, have larger extremes, given in the notes).")
         L.append("")
         for ex, R in results.items():
@@ -749,9 +749,9 @@ def build_doc(results, meta, img_rel, facet):
                 f = "max" if png.stem.endswith("max") else "min"
                 L.append("![%s, %s principal stress](%s/%s)" % (ex, f, img_rel, png.name))
             L.append("")
-    L.append("Produced by `%s` on %s: sc-pipeline %s, repository at git %s, CalculiX %s, matplotlib %s, meshio %s." % (
-        meta["command"], meta["date"], meta["sc_version"], meta["git"], meta["ccx_version"],
-        meta["mpl"], meta["meshio"]))
+    # the versions that produced the section; when and from which commit is git's to say
+    L.append("Produced by `%s`: sc-pipeline %s, CalculiX %s, matplotlib %s, meshio %s." % (
+        meta["command"], meta["sc_release"], meta["ccx_version"], meta["mpl"], meta["meshio"]))
     return "\n".join(L)
 
 
@@ -850,6 +850,7 @@ def main(argv=None):
                 + (" " + " ".join(argv if argv is not None else sys.argv[1:])).rstrip(),
                 date=datetime.date.today().isoformat(),
                 sc_version="%s (release build of %s)" % (ver[-1] if ver else "?", built.strftime("%Y-%m-%d %H:%M UTC")),
+                sc_release=ver[-1] if ver else "?",
                 git=git_head(),
                 ccx_version=ccx_version, mpl=matplotlib.__version__, meshio=meshio.__version__)
     doc = Path(a.doc).resolve()

@@ -23,7 +23,7 @@ use nalgebra::Vector3;
 use super::pair::{PairError, PairSolver};
 use crate::fem::hex8::reference_gradients;
 use crate::fem::quadrature::GAUSS_HEX_2X2X2;
-use crate::solver::problem::ContactDefinition;
+use super::definition::ContactDefinition;
 
 /// One slave node that the adjust moved.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -23,51 +23,18 @@
 //! ```
 //! (rows: δu, columns: Δu; symmetric, it is the Hessian of g_N). A node in contact
 //! with a crease of a facet master (`sp.clamped`) is evaluated by the dual-number
-//! element of [`super::friction`] with no friction. The derivation is in
+//! element of [`super::dual_element`] with no friction. The derivation is in
 //! `docs/theory.md`; the tests check `K` against central differences of `r` with the
 //! slave node re-projected at every perturbation.
 
 use nalgebra::{DMatrix, DVector, DVectorView};
 
+pub use super::law::{ContactElementError, ContactState, NormalLaw};
+use super::law::FrictionLaw;
 use crate::spline::{BSplinePatch, FacetSurface, SurfacePoint, Vec3, MAX_NODES};
 
 /// Largest element size `3(1 + n_c)`.
 const MAX_DOFS: usize = 3 * (1 + MAX_NODES);
-
-/// Outcome of one slave-node evaluation.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ContactState {
-    /// Normal gap g_N = (x_s − x̄)·n̄ (negative = penetration).
-    pub g_n: f64,
-    /// Contact pressure t_N = min(0, λ_N + ε_N g_N) (≤ 0; compressive).
-    pub t_n: f64,
-    /// Whether λ_N + ε_N g_N < 0 (the node carries force).
-    pub active: bool,
-}
-
-/// The local contact problem has no unique solution.
-#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
-pub enum ContactElementError {
-    /// ā_αβ − g_N b̄_αβ is singular: the slave node sits at a centre of curvature of
-    /// the master (so deep inside it that the closest point is not unique).
-    #[error("slave node at a centre of curvature of the master (g_N = {g_n:e}): the closest point is not unique")]
-    FocalPoint { g_n: f64 },
-}
-
-/// The contact law of one slave node (eq. 4.2).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct NormalLaw {
-    /// Lagrange multiplier λ_N (≤ 0), fixed during a Newton solve.
-    pub lambda_n: f64,
-    /// Penalty ε_N.
-    pub eps_n: f64,
-    /// Tributary area A_s of the slave node (eq. 6.1).
-    pub area: f64,
-    /// A node that is not active but has λ_N + ε_N g_N ≤ ε_N·touch (touching within
-    /// `touch`, a length) contributes the closed-branch stiffness ε_N A_s N Nᵀ with no
-    /// force, so a body that starts touching is not free (see `docs/theory.md`).
-    pub touch: f64,
-}
 
 /// The master surface kind: the B-spline patch or the bilinear facets over the same net.
 #[derive(Debug, Clone, Copy)]
@@ -163,8 +130,8 @@ pub fn normal_contact(
     }
     if sp.on_crease() {
         // contact with a crease of a facet set: the normal follows the distance
-        // vector, ξ̄ moves only along the crease (see `super::friction`)
-        let st = super::friction::frictional_contact(xs, sp, law, &super::friction::FrictionLaw::NONE, r, k)?;
+        // vector, ξ̄ moves only along the crease (see `super::dual_element`)
+        let st = super::dual_element::evaluate(xs, sp, law, &FrictionLaw::NONE, None, r, Some(k), None)?;
         return Ok(ContactState { g_n: st.g_n, t_n: st.t_n, active: st.active });
     }
     let t = trial;

@@ -22,42 +22,13 @@ use rayon::prelude::*;
 use super::element::{normal_contact, ContactElementError, NormalLaw};
 use super::friction::{friction_state, frictional_contact, tangential_state, FrictionLaw};
 use crate::format::sccontact::MasterKind;
-use crate::solver::problem::ContactDefinition;
-use crate::format::setup::{Enforcement, Integration};
+use super::definition::ContactDefinition;
+pub use super::settings::PairSettings;
+use super::settings::{Enforcement, Integration};
 use super::master::Projector;
 use super::mortar::element::{mortar_contact, NodeFriction};
 use super::mortar::{Mortar, MortarError};
 use crate::spline::{Projection, SplineError, SurfacePoint, Vec3};
-
-/// Settings of a pair, resolved (absolute lengths).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct PairSettings {
-    pub eps_n: f64,
-    pub enforcement: Enforcement,
-    /// Largest accepted penetration (length), augmented Lagrangian.
-    pub penetration_tolerance: f64,
-    pub max_augmentations: u32,
-    /// Retries of a failed solve with half the last Uzawa update (`solver::uzawa`).
-    pub update_halvings: u32,
-    /// Coulomb coefficient μ and tangential penalty ε_T (μ = 0: frictionless).
-    pub mu: f64,
-    pub eps_t: f64,
-    /// Master-surface stabilisation factor η (0: off): an artificial inertia of
-    /// stiffness η ε_N Ā_s on the master net's nodes (`solver::stabilization`).
-    pub stabilization: f64,
-    /// Node-to-surface or mortar (`contact::mortar`).
-    pub integration: Integration,
-    /// Mortar: the multiplier basis.
-    pub multipliers: crate::format::setup::MortarMultipliers,
-    /// Mortar: the basis the master receives the forces through.
-    pub transfer: crate::format::setup::MortarTransfer,
-}
-
-impl PairSettings {
-    pub fn frictional(&self) -> bool {
-        self.mu > 0.0
-    }
-}
 
 /// Where a slave node stands after the last search / state update.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

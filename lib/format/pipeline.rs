@@ -23,6 +23,9 @@ use serde::Deserialize;
 
 use crate::stages::export::ExportFormat;
 use crate::format::setup::SolveSetup;
+// the pipeline's paths are resolved against its folder (defined with the other
+// file-system helpers)
+pub use crate::format::stage::files::resolve;
 use crate::stages::gmsh::MshFlavour;
 use crate::stages::plot::PlotSpec;
 use crate::stages::tag::PairSpec;
@@ -186,16 +189,6 @@ impl Pipeline {
         let shown = path.display().to_string();
         let text = std::fs::read_to_string(path).map_err(|source| PipelineError::Io { path: shown.clone(), source })?;
         Self::parse(&shown, &text)
-    }
-}
-
-/// Resolve a path from the YAML against the YAML's folder (absolute paths and `-`
-/// are kept as they are).
-pub fn resolve(base: &Path, p: &Path) -> PathBuf {
-    if p.is_absolute() || p.as_os_str() == "-" {
-        p.to_path_buf()
-    } else {
-        base.join(p)
     }
 }
 

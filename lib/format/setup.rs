@@ -17,6 +17,10 @@
 
 use serde::{Deserialize, Serialize};
 
+// The contact settings are the contact layer's own plain data; this file reads
+// and writes them (re-exported here, where the setup's readers look for them).
+pub use crate::contact::settings::{Enforcement, Integration, MortarMultipliers, MortarTransfer, UPDATE_HALVINGS};
+
 /// Material models.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -408,60 +412,6 @@ impl<'de> Deserialize<'de> for LinearSolverSetup {
     }
 }
 
-/// How a pair's normal constraint is enforced (paper sec. 4).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, Default)]
-#[serde(rename_all = "snake_case")]
-pub enum Enforcement {
-    /// t_N = min(0, ε_N g_N): λ_N stays 0, the penetration is ε_N-dependent.
-    Penalty,
-    /// t_N = min(0, λ_N + ε_N g_N) with Uzawa updates λ_N ← t_N after each converged
-    /// Newton solve until the penetration is below the tolerance.
-    #[default]
-    AugmentedLagrangian,
-}
-
-/// Where a pair's normal constraint is imposed.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, Default)]
-#[serde(rename_all = "snake_case")]
-pub enum Integration {
-    /// At the slave nodes, one closest-point projection each (the paper's
-    /// node-to-surface method, eqs. 2.2, 6.2).
-    #[default]
-    Node,
-    /// Integrated over the slave faces, segment by segment against the master cells,
-    /// with multipliers at the slave nodes (`contact::mortar`): passes the contact
-    /// patch test. Needs a face-set slave; friction acts at the slave nodes, bounded
-    /// by the mortar pressure.
-    Mortar,
-}
-
-/// The multiplier basis of a mortar pair (`contact::mortar`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, Default)]
-#[serde(rename_all = "snake_case")]
-pub enum MortarMultipliers {
-    /// Φ_s = N_s, the slave faces' bilinear functions.
-    #[default]
-    Standard,
-    /// Biorthogonal to N_s per face (Wohlmuth 2000): each slave node couples only to
-    /// its own multiplier.
-    Dual,
-}
-
-/// Through which basis a mortar pair's master receives the contact forces
-/// (`contact::mortar`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, Default)]
-#[serde(rename_all = "snake_case")]
-pub enum MortarTransfer {
-    /// The master body's facets (its own hex8 faces): the consistent nodal forces of
-    /// a uniform pressure, the contact patch test exact with every master.
-    #[default]
-    Trace,
-    /// The master surface's basis (the B-spline's Q_A, eq. 6.2): the variation of the
-    /// gap, a symmetric tangent and smoother force histories in sliding; the patch
-    /// test is exact only with facets.
-    Surface,
-}
-
 /// Contact settings of one pair of the `.sccontact` model (by its name).
 #[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
@@ -546,7 +496,7 @@ fn default_max_augmentations() -> u32 {
 }
 
 fn default_update_halvings() -> u32 {
-    crate::solver::uzawa::UPDATE_HALVINGS
+    UPDATE_HALVINGS
 }
 
 /// The whole setup.

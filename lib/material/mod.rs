@@ -34,9 +34,11 @@
 #![allow(non_snake_case)]
 
 pub mod linear;
+pub mod model;
 pub mod neo_hookean;
 
 pub use linear::LinearElastic;
+pub use model::MaterialModel;
 pub use neo_hookean::{CiarletSimo, DevVolNeoHookean};
 
 use nalgebra::{Matrix3, SMatrix, Vector6};
@@ -116,68 +118,6 @@ pub trait Material: Sync {
     fn is_geometrically_linear(&self) -> bool;
     /// Shear modulus μ (stress scale, used for tolerances and reports).
     fn shear_modulus(&self) -> f64;
-}
-
-/// The material of one body, as the solver configuration holds it.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum MaterialModel {
-    CiarletSimo(CiarletSimo),
-    DevVolNeoHookean(DevVolNeoHookean),
-    LinearElastic(LinearElastic),
-}
-
-impl MaterialModel {
-    fn inner(&self) -> &dyn Material {
-        match self {
-            MaterialModel::CiarletSimo(m) => m,
-            MaterialModel::DevVolNeoHookean(m) => m,
-            MaterialModel::LinearElastic(m) => m,
-        }
-    }
-}
-
-impl From<CiarletSimo> for MaterialModel {
-    fn from(m: CiarletSimo) -> Self {
-        MaterialModel::CiarletSimo(m)
-    }
-}
-impl From<DevVolNeoHookean> for MaterialModel {
-    fn from(m: DevVolNeoHookean) -> Self {
-        MaterialModel::DevVolNeoHookean(m)
-    }
-}
-impl From<LinearElastic> for MaterialModel {
-    fn from(m: LinearElastic) -> Self {
-        MaterialModel::LinearElastic(m)
-    }
-}
-
-impl Material for MaterialModel {
-    #[inline]
-    fn stress_tangent(&self, F: &Matrix3<f64>) -> Result<(Matrix3<f64>, Tangent), MaterialError> {
-        match self {
-            MaterialModel::CiarletSimo(m) => m.stress_tangent(F),
-            MaterialModel::DevVolNeoHookean(m) => m.stress_tangent(F),
-            MaterialModel::LinearElastic(m) => m.stress_tangent(F),
-        }
-    }
-    #[inline]
-    fn stress(&self, F: &Matrix3<f64>) -> Result<Matrix3<f64>, MaterialError> {
-        match self {
-            MaterialModel::CiarletSimo(m) => m.stress(F),
-            MaterialModel::DevVolNeoHookean(m) => m.stress(F),
-            MaterialModel::LinearElastic(m) => m.stress(F),
-        }
-    }
-    fn energy(&self, F: &Matrix3<f64>) -> Result<f64, MaterialError> {
-        self.inner().energy(F)
-    }
-    fn is_geometrically_linear(&self) -> bool {
-        self.inner().is_geometrically_linear()
-    }
-    fn shear_modulus(&self) -> f64 {
-        self.inner().shear_modulus()
-    }
 }
 
 /// (A ⊗ B)_ijkl = A_ij B_kl in Voigt form (A, B symmetric).

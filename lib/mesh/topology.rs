@@ -11,7 +11,6 @@
 //!      0-------1          +---- ξ
 //! ```
 
-use super::Vec3;
 
 /// Local faces of the hexahedron, each listed so that the right-hand rule gives the
 /// outward normal: ζ=-1, ζ=+1, η=-1, ξ=+1, η=+1, ξ=-1.
@@ -40,11 +39,11 @@ pub fn find_local_face(hex: &[u32; 8], quad: &[u32; 4]) -> Option<usize> {
     })
 }
 
-fn sub(a: Vec3, b: Vec3) -> Vec3 {
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
-fn triple(a: Vec3, b: Vec3, c: Vec3) -> f64 {
+fn triple(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
     a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
         + a[2] * (b[0] * c[1] - b[1] * c[0])
 }
@@ -52,7 +51,7 @@ fn triple(a: Vec3, b: Vec3, c: Vec3) -> f64 {
 /// Jacobian determinant of the trilinear map at each of the 8 corners
 /// (det of the three edge vectors leaving the corner in ξ, η, ζ order).
 /// All positive for a valid hexahedron in gmsh order; all negative for a mirrored one.
-pub fn corner_jacobians(x: &[Vec3; 8]) -> [f64; 8] {
+pub fn corner_jacobians(x: &[[f64; 3]; 8]) -> [f64; 8] {
     // For each corner: neighbours along +ξ, +η, +ζ directions (in the corner's own frame).
     const NB: [[usize; 3]; 8] = [
         [1, 3, 4],
@@ -81,7 +80,7 @@ pub fn flip_hex(hex: &[u32; 8]) -> [u32; 8] {
 mod tests {
     use super::*;
 
-    fn unit_cube() -> [Vec3; 8] {
+    fn unit_cube() -> [[f64; 3]; 8] {
         [
             [0., 0., 0.],
             [1., 0., 0.],

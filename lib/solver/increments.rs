@@ -15,7 +15,7 @@ use super::uzawa::solve_augmented;
 use crate::contact::pair::SlaveStatus;
 use crate::format::sccontact::MasterKind;
 use crate::format::scres::{FrictionSummary, PairSummary};
-use crate::format::setup::Enforcement;
+use crate::contact::settings::Enforcement;
 use super::problem::Problem;
 use super::restart::factors_done;
 use crate::assembly::DOFS_PER_NODE;

@@ -21,7 +21,7 @@ use super::problem::Problem;
 use super::ranks;
 use super::stabilization::Stabilization;
 use crate::assembly::{Assembly, AssemblyError, ElementFailure, NodeGroups, Pattern, PatternError, DOFS_PER_NODE};
-use crate::contact::element::ContactElementError;
+use crate::contact::law::ContactElementError;
 use crate::contact::pair::{PairError, PairSolver, SearchShare};
 use crate::fem::element::{hex8_gauss_stresses, hex8_residual_tangent, ElementError};
 use crate::fem::pressure::{follower_pressure_force_stiffness, FaceMatrix, FaceVector};

@@ -24,7 +24,7 @@
 //! — provided no two calls run at once: the generator's state is a global of
 //! GKlib's, so calls are serialised by [`METIS_LOCK`].
 
-use super::linear::LinearSolverError;
+use super::linear::error::LinearSolverError;
 use faer::sparse::SymbolicSparseColMatRef;
 
 /// Serialises the calls into METIS (its random generator is a process global).

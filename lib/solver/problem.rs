@@ -10,11 +10,13 @@ use nalgebra::Vector3;
 use super::amplitude::Amplitude;
 use crate::assembly::{DofMap, DOFS_PER_NODE};
 use crate::contact::adjust::{adjust_pair, AdjustError, PairAdjustment};
-use crate::contact::pair::PairSettings;
+// re-exported: the problem holds its contact pairs as `ContactDefinition`s
+pub use crate::contact::definition::ContactDefinition;
+use crate::contact::settings::{Integration, PairSettings};
 use crate::contact::tributary::tributary_areas;
-use crate::format::sccontact::{ContactPair, MasterKind, SlaveKind};
+use crate::format::sccontact::{ContactPair, SlaveKind};
 use crate::fem::element::Formulation;
-use crate::format::setup::{self, Integration, ModelName, SolveSetup};
+use crate::format::setup::{self, ModelName, SolveSetup};
 use crate::material::linear::LinearElastic;
 use crate::material::neo_hookean::{CiarletSimo, DevVolNeoHookean};
 use crate::material::{MaterialError, MaterialModel};
@@ -56,37 +58,6 @@ pub struct Prescribed {
     pub value: f64,
     /// Index into `Problem::amplitudes`.
     pub amplitude: u32,
-}
-
-/// A contact pair of the model with its settings from the setup.
-#[derive(Debug, Clone)]
-pub struct ContactDefinition {
-    pub pair: ContactPair,
-    pub settings: PairSettings,
-    /// Tributary area of each slave node (eq. 6.1), order of `pair.slave_nodes`.
-    pub areas: Vec<f64>,
-    /// The slave faces (mesh node ids, cycle order; empty for a node-set slave).
-    pub slave_faces: Vec<[u32; 4]>,
-    /// Mean edge length of the master net (reference configuration).
-    pub h_master: f64,
-    /// ε_N was not given: [`default_penalty`].
-    pub eps_n_default: bool,
-    /// `adjust` distance of the setup (None: off).
-    pub adjust: Option<f64>,
-    /// The setup accepts a master whose normal points away from the slave body.
-    pub allow_flipped_master: bool,
-}
-
-impl ContactDefinition {
-    /// Whether the pair's contact tangent is symmetric: frictionless, and the master
-    /// virtual displacement the variation of its geometry (node-to-surface; mortar
-    /// with facets, whose trace is the surface itself). Slip, and a mortar pair's
-    /// B-spline master (geometry from the patch, forces through the facet trace of
-    /// the segment's cell, `contact::mortar`) make it non-symmetric.
-    pub fn symmetric_tangent(&self) -> bool {
-        let trace_is_geometry = self.pair.master_kind == MasterKind::Facet || self.settings.transfer == crate::format::setup::MortarTransfer::Surface;
-        !self.settings.frictional() && (self.settings.integration == Integration::Node || trace_is_geometry)
-    }
 }
 
 /// The problem.

@@ -92,7 +92,7 @@ pub fn participate(program: &str, distributed: bool) -> Result<Participation, St
     let _ = distributed;
     #[cfg(feature = "petsc")]
     if distributed {
-        super::petsc::initialize().map_err(|e| e.to_string())?;
+        super::petsc::runtime::initialize().map_err(|e| e.to_string())?;
         let (rank, size) = rank_and_size();
         return Ok(Participation::Rank { rank, size });
     }
@@ -111,7 +111,7 @@ pub fn participate(program: &str, distributed: bool) -> Result<Participation, St
 /// The program's last word to MPI: stops PETSc and MPI when they were started.
 pub fn finish() {
     #[cfg(feature = "petsc")]
-    super::petsc::finalize();
+    super::petsc::runtime::finalize();
 }
 
 /// How [`reduce_over_ranks`] combines the ranks' values.
@@ -125,7 +125,11 @@ pub enum Reduction {
 pub fn reduce_over_ranks(x: &mut [f64], op: Reduction) -> Result<(), String> {
     #[cfg(feature = "petsc")]
     {
-        super::petsc::runtime::reduce_over_ranks(x, op).map_err(|e| e.to_string())
+        let reduced = match op {
+            Reduction::Sum => super::petsc::runtime::sum_over_ranks(x),
+            Reduction::Max => super::petsc::runtime::max_over_ranks(x),
+        };
+        reduced.map_err(|e| e.to_string())
     }
     #[cfg(not(feature = "petsc"))]
     {

@@ -11,16 +11,13 @@
 //! When Newton fails after an update, the update was too large a step for it (an
 //! update moves every pressed node's force at once): the solve is retried from the
 //! state the update started from with half the update, λ_N = λ_N,old + ½ Δλ_N, then a
-//! quarter, an eighth (the pairs' `update_halvings`, default [`UPDATE_HALVINGS`]),
+//! quarter, an eighth (the pairs' `update_halvings`, default
+//! [`UPDATE_HALVINGS`](crate::contact::settings::UPDATE_HALVINGS)),
 //! before the failure goes to the load stepping as a cutback.
 
 use super::newton::{Converged, IncrementFailure, Newton};
 use crate::contact::pair::Multipliers;
 use crate::format::scres::IterationLog;
-
-/// How often a failed solve after an Uzawa update is retried with half the update,
-/// by default.
-pub const UPDATE_HALVINGS: u32 = 3;
 
 /// Newton plus Uzawa updates at load factor `lambda`; `u` is updated in place.
 /// `note` receives one line per update.

@@ -1,8 +1,10 @@
 //! The pipeline stages as library calls. Each binary (`sc-import`, `sc-export`, …)
 //! and the pipeline runner call these same functions, so a stage behaves the same
-//! from the shell and from a pipeline YAML.
+//! from the shell and from a pipeline YAML. Every stage fails with a
+//! [`StageRunError`], which names the process's [`exit_code`].
 
 pub mod check;
+pub mod exit_code;
 pub mod export;
 pub mod gmsh;
 pub mod import;
@@ -22,14 +24,6 @@ use crate::format::vtk::VtkError;
 use plot::PlotError;
 use tag::TagError;
 
-/// Exit codes shared by every binary (ripgrep style): 0 success, 1 an I/O or
-/// environment failure, 2 bad input (file, mesh, setup), 3 a solve that did not
-/// converge (converged increments are kept on disk).
-pub mod exit_code {
-    pub const IO: u8 = 1;
-    pub const BAD_INPUT: u8 = 2;
-    pub const DIVERGED: u8 = 3;
-}
 
 /// Why a stage failed. Every variant carries the file (and line, element or set)
 /// at fault in its message.

@@ -23,8 +23,9 @@
 use nalgebra::{DMatrix, DVector};
 
 use super::{Mortar, Transfer};
-use crate::contact::element::{zero_element, ContactElementError, ContactState, NormalLaw};
-use crate::contact::friction::{tangential_contact, FrictionLaw};
+use crate::contact::element::zero_element;
+use crate::contact::friction::tangential_contact;
+use crate::contact::law::{ContactElementError, ContactState, FrictionLaw, NormalLaw};
 use crate::contact::master::Projector;
 use crate::spline::{SurfacePoint, Vec3};
 

@@ -42,8 +42,8 @@ use self::segment::{clip_convex, face_jacobian, face_point, is_convex_ccw, polyg
 use super::master::Projector;
 use crate::spline::{FacetProjector, FacetSurface, Projection, SplineError, SurfacePoint, Vec3};
 
-pub use crate::format::setup::MortarMultipliers as Multipliers;
-pub use crate::format::setup::MortarTransfer as Transfer;
+pub use crate::contact::settings::MortarMultipliers as Multipliers;
+pub use crate::contact::settings::MortarTransfer as Transfer;
 
 const IDENTITY: [[f64; 4]; 4] = [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]];
 

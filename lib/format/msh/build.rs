@@ -9,9 +9,23 @@ use super::header::Header;
 use super::nodes::Nodes;
 use super::physical_names::PhysicalName;
 use super::types::element_type;
-use super::{ImportReport, MshError};
+use super::error::MshError;
 use crate::mesh::topology::{find_local_face, hex_face_nodes};
 use crate::mesh::{Body, FaceSet, HexFace, Mesh, NodeSet};
+
+/// What the import did besides building the mesh.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ImportReport {
+    /// `"2.2 ASCII"`, `"4.1 binary"`, ...
+    pub version: String,
+    /// gmsh tags of the nodes used by no hexahedron, which were dropped.
+    pub dropped_nodes: Vec<u64>,
+    /// gmsh tags of the mirrored hexahedra that were reordered.
+    pub flipped_elements: Vec<u64>,
+    /// What was read but not as expected, each naming the file (and the line where
+    /// there is one): printed by every caller, even when asked to be quiet.
+    pub warnings: Vec<String>,
+}
 
 /// Name of the body holding hexahedra that belong to no physical volume.
 pub const UNNAMED_VOLUME: &str = "unnamed_volume";

@@ -13,9 +13,6 @@
 use super::cursor::{show, Cursor};
 use super::MshError;
 
-/// The MSH versions this reader understands.
-pub const SUPPORTED: &str = "2.2, 4.1";
-
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(super) enum Version {
     V2_2,

@@ -56,7 +56,6 @@ mod ffi;
 pub mod runtime;
 
 use std::ffi::{c_int, CString};
-use std::sync::Mutex;
 use std::time::Instant;
 
 use faer::sparse::SymbolicSparseColMatRef;
@@ -65,13 +64,8 @@ use nalgebra::Vector3;
 use self::ffi::*;
 use super::block_rows::BlockRows;
 use super::linear::{FactorInfo, Factorization, LinearSolver, LinearSolverError, SolveReport, SolverTimings, Symmetry};
-use super::ranks::{owned_nodes, Reduction};
+use super::ranks::owned_nodes;
 pub use runtime::{finalize, initialize, PetscError};
-
-/// Every PETSc call of the process goes through this lock: PETSc's global state
-/// (options, logging, memory tracking) is not thread-safe, and tests run solvers on
-/// several threads.
-static LOCK: Mutex<()> = Mutex::new(());
 
 /// Settings of [`PetscKrylov`].
 #[derive(Debug, Clone, PartialEq)]
@@ -148,7 +142,7 @@ pub struct PetscKrylov {
     timings: SolverTimings,
 }
 
-// The handles are only touched under LOCK, by the thread that owns the solver.
+// The handles are only touched under runtime::LOCK, by the thread that owns the solver.
 unsafe impl Send for PetscKrylov {}
 
 impl PetscKrylov {
@@ -329,7 +323,7 @@ impl PetscKrylov {
 
 impl Drop for PetscKrylov {
     fn drop(&mut self) {
-        let _guard = LOCK.lock().unwrap_or_else(|p| p.into_inner());
+        let _guard = runtime::LOCK.lock().unwrap_or_else(|p| p.into_inner());
         self.release();
     }
 }
@@ -341,7 +335,7 @@ impl LinearSolver for PetscKrylov {
 
     fn analyse(&mut self, pattern: SymbolicSparseColMatRef<'_, usize>, symmetry: Symmetry) -> Result<(), LinearSolverError> {
         let start = Instant::now();
-        let _guard = LOCK.lock().unwrap_or_else(|p| p.into_inner());
+        let _guard = runtime::LOCK.lock().unwrap_or_else(|p| p.into_inner());
         self.release();
         self.rows = None;
         self.block_values = Vec::new();
@@ -361,14 +355,14 @@ impl LinearSolver for PetscKrylov {
 
     fn factor(&mut self, values: &[f64]) -> Result<FactorInfo, LinearSolverError> {
         let start = Instant::now();
-        let _guard = LOCK.lock().unwrap_or_else(|p| p.into_inner());
+        let _guard = runtime::LOCK.lock().unwrap_or_else(|p| p.into_inner());
         let Some(rows) = self.rows.as_ref() else {
             return Err(LinearSolverError::Order("factor", "analyse"));
         };
         // a non-finite value stops every rank (the calls that follow are collective)
         let bad = values.iter().position(|v| !v.is_finite());
         let mut any_bad = [f64::from(u8::from(bad.is_some()))];
-        runtime::reduce_over_ranks(&mut any_bad, Reduction::Max).map_err(|e| LinearSolverError::Backend(e.to_string()))?;
+        runtime::max_over_ranks(&mut any_bad).map_err(|e| LinearSolverError::Backend(e.to_string()))?;
         if any_bad[0] > 0.0 {
             return Err(match bad {
                 Some(index) => LinearSolverError::NonFinite { index },
@@ -380,7 +374,7 @@ impl LinearSolver for PetscKrylov {
         // only this rank's rows are complete (and inserted); whether the tangent is
         // indefinite is decided by all ranks together, as what follows is collective
         let mut count = [self.non_positive.iter().filter(|&&g| g >= 3 * first && g < 3 * last).count() as f64];
-        runtime::reduce_over_ranks(&mut count, Reduction::Sum).map_err(|e| LinearSolverError::Backend(e.to_string()))?;
+        runtime::sum_over_ranks(&mut count).map_err(|e| LinearSolverError::Backend(e.to_string()))?;
         self.indefinite_total = count[0] as usize;
         unsafe {
             for i in first..last {
@@ -423,7 +417,7 @@ impl LinearSolver for PetscKrylov {
 
     fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolverError> {
         let start = Instant::now();
-        let _guard = LOCK.lock().unwrap_or_else(|p| p.into_inner());
+        let _guard = runtime::LOCK.lock().unwrap_or_else(|p| p.into_inner());
         if self.mat.is_null() || self.ksp.is_null() {
             return Err(LinearSolverError::Order("solve", "factor"));
         }

@@ -5,10 +5,14 @@
 //! agrees on its rank from the start, and call [`finalize`] before it exits.
 
 use std::ffi::{c_int, CStr};
-use std::sync::OnceLock;
+use std::sync::{Mutex, OnceLock};
 
 use super::ffi::*;
-use crate::solver::ranks::Reduction;
+
+/// Every PETSc call of the process goes through this lock: PETSc's global state
+/// (options, logging, memory tracking) is not thread-safe, and tests run solvers on
+/// several threads.
+pub(super) static LOCK: Mutex<()> = Mutex::new(());
 
 /// A PETSc call that failed: the function, PETSc's code and its message.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -21,7 +25,7 @@ static STARTED: OnceLock<Result<(), PetscError>> = OnceLock::new();
 pub fn initialize() -> Result<(), PetscError> {
     STARTED
         .get_or_init(|| {
-            let _guard = super::LOCK.lock().unwrap_or_else(|p| p.into_inner());
+            let _guard = LOCK.lock().unwrap_or_else(|p| p.into_inner());
             let code = unsafe { sc_initialize() };
             if code != 0 {
                 return Err(PetscError(describe("PetscInitialize", code)));
@@ -43,7 +47,7 @@ pub fn is_initialized() -> bool {
 /// Stops PETSc and MPI (the program's last PETSc call; nothing may follow).
 pub fn finalize() {
     if is_initialized() {
-        let _guard = super::LOCK.lock().unwrap_or_else(|p| p.into_inner());
+        let _guard = LOCK.lock().unwrap_or_else(|p| p.into_inner());
         unsafe {
             PetscFinalize();
         }
@@ -58,18 +62,23 @@ pub fn rank_and_size() -> (usize, usize) {
     unsafe { (sc_comm_rank().max(0) as usize, sc_comm_size().max(1) as usize) }
 }
 
-/// Combines `x` over all ranks, in place: the sum or the largest value of each entry.
-pub fn reduce_over_ranks(x: &mut [f64], op: Reduction) -> Result<(), PetscError> {
+/// Sums `x` over all ranks, entry by entry, in place.
+pub fn sum_over_ranks(x: &mut [f64]) -> Result<(), PetscError> {
+    all_reduce(x, sc_allreduce_sum_f64)
+}
+
+/// The largest value of each entry of `x` over all ranks, in place.
+pub fn max_over_ranks(x: &mut [f64]) -> Result<(), PetscError> {
+    all_reduce(x, sc_allreduce_max_f64)
+}
+
+/// `MPI_Allreduce` of `x` in place by one of the shim's reductions.
+fn all_reduce(x: &mut [f64], reduce: unsafe extern "C" fn(*mut f64, c_int) -> c_int) -> Result<(), PetscError> {
     if x.is_empty() || rank_and_size().1 == 1 {
         return Ok(());
     }
     let (ptr, n) = (x.as_mut_ptr(), x.len() as c_int);
-    let code = unsafe {
-        match op {
-            Reduction::Sum => sc_allreduce_sum_f64(ptr, n),
-            Reduction::Max => sc_allreduce_max_f64(ptr, n),
-        }
-    };
+    let code = unsafe { reduce(ptr, n) };
     if code != 0 {
         return Err(PetscError(format!("MPI_Allreduce failed with code {code}")));
     }

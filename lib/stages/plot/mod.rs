@@ -14,6 +14,7 @@
 //! `docs/pipelines.md`); [`render`] draws it.
 
 pub mod args;
+pub mod figure;
 pub mod render;
 pub mod text;
 
@@ -23,10 +24,11 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 
 use crate::format::csv::{CsvError, Table};
-use crate::format::pipeline::resolve;
+use crate::format::stage::files::resolve;
 use crate::format::stage::{write_atomic, StageError};
 
 use super::exit_code;
+pub use figure::{Figure, Panel, Series};
 
 /// Default image width in pixels.
 pub const DEFAULT_WIDTH: u32 = 1000;
@@ -135,34 +137,6 @@ impl PlotError {
             _ => exit_code::BAD_INPUT,
         }
     }
-}
-
-/// A series ready to draw.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Series {
-    pub label: String,
-    /// (x, y) in row order.
-    pub points: Vec<(f64, f64)>,
-}
-
-/// A panel ready to draw.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Panel {
-    pub y_label: Option<String>,
-    /// The y axis (lo < hi).
-    pub y_range: (f64, f64),
-    pub series: Vec<Series>,
-}
-
-/// Everything [`render`] needs: no file names, only numbers and text.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Figure {
-    pub title: Option<String>,
-    pub x_label: String,
-    pub size: (u32, u32),
-    /// The shared x axis (lo < hi).
-    pub x_range: (f64, f64),
-    pub panels: Vec<Panel>,
 }
 
 /// The points of one series from its table: (x_i, s · Y_i / D_i) over the rows,

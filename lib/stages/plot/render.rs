@@ -19,7 +19,7 @@ use plotters::prelude::*;
 use plotters::style::{register_font, FontStyle};
 
 use super::text::TextBackend;
-use super::{Figure, Panel};
+use super::figure::{Figure, Panel};
 
 /// DejaVu Sans 2.37, unmodified (Bitstream Vera / Arev licence in `assets/fonts/`).
 static DEJAVU_SANS: &[u8] = include_bytes!("../../../assets/fonts/DejaVuSans.ttf");

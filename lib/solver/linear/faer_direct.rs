@@ -1,13 +1,4 @@
-//! The linear-solver interface and the faer direct backend.
-//!
-//! **One small interface.** Every backend (this sparse direct one; a PETSc/AMG
-//! Krylov one under MPI later) implements [`LinearSolver`]:
-//! `analyse(pattern, symmetry)` once per sparsity pattern, `factor(values)` once
-//! per Newton iteration (for an iterative backend: build the preconditioner),
-//! `solve_in_place(rhs)` per right-hand side. The values are always in the CSC
-//! order of the pattern given to `analyse` (the order of
-//! [`crate::assembly::Pattern`] and [`crate::assembly::Assembly::values`]); a
-//! distributed backend would receive the locally owned columns in the same form.
+//! The faer sparse direct backend, [`FaerDirect`].
 //!
 //! **Symbolic once, numeric many.** [`FaerDirect`] computes the fill-reducing
 //! ordering and the symbolic factorization in `analyse` and reuses them for every
@@ -15,13 +6,13 @@
 //! of [`Symmetry`] needs a new `analyse`.
 //!
 //! **Which factorization.** [`Symmetry::Symmetric`]: `LLᵀ` (Cholesky, nested
-//! dissection or AMD ordering ([`super::ordering`]), supernodal) for the symmetric positive definite tangent; when it
+//! dissection or AMD ordering ([`crate::solver::ordering`]), supernodal) for the symmetric positive definite tangent; when it
 //! meets a non-positive pivot, `LDLᵀ` on the same symbolic factorization
 //! (symmetric indefinite, no pivoting: fails only on a zero pivot).
 //! [`Symmetry::General`]: `LU` with partial pivoting (COLAMD ordering). On 3D
 //! meshes its fill explodes (the frictional crossed beams at 109k dofs: 24 s and
 //! 8.2 GB for one LU), so the frictional tangent goes by default to
-//! [`super::symmetric_part::SymmetricPartGmres`], which factors only the symmetric
+//! [`crate::solver::symmetric_part::SymmetricPartGmres`], which factors only the symmetric
 //! part and keeps this LU as its fallback (`docs/performance.md`).
 //!
 //! **Singularity.** faer reports exact zero / non-positive pivots; a body that is
@@ -58,130 +49,9 @@ use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRe
 use faer::perm::PermRef;
 use faer::{Conj, MatMut, Par, Side};
 
-use super::ordering::{nested_dissection, FillOrdering};
-
-/// Structure of the matrix, chosen by the caller (the tangent is symmetric
-/// without friction, non-symmetric with it).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Symmetry {
-    /// Symmetric; both triangles are stored, the lower one is read.
-    Symmetric,
-    /// Non-symmetric.
-    General,
-}
-
-/// The factorization actually computed.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Factorization {
-    Llt,
-    Ldlt,
-    Lu,
-    /// No factorization: an algebraic-multigrid preconditioner (built or kept).
-    Multigrid,
-}
-
-/// What one `factor` call did.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct FactorInfo {
-    pub method: Factorization,
-    /// Wall time of this numeric factorization (including a failed `LLᵀ` before
-    /// the `LDLᵀ` fallback).
-    pub time: Duration,
-}
-
-/// Accumulated wall times, split by phase, and call counts.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct SolverTimings {
-    /// Ordering + symbolic factorization (`analyse`).
-    pub symbolic: Duration,
-    /// Numeric factorizations (`factor`).
-    pub numeric: Duration,
-    /// Triangular solves (`solve_in_place`).
-    pub solve: Duration,
-    pub n_symbolic: usize,
-    pub n_numeric: usize,
-    pub n_solve: usize,
-    /// Krylov iterations over all solves (iterative backends).
-    pub n_krylov: usize,
-    /// Solves an iterative backend handed to its direct fallback.
-    pub n_fallback: usize,
-    /// `factor` calls that kept an earlier preconditioner instead of factoring.
-    pub n_reused: usize,
-}
-
-/// What the last `solve_in_place` did, for the log.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct SolveReport {
-    /// Krylov iterations (0 for a direct solve).
-    pub krylov_iterations: usize,
-    /// Why an iterative backend solved this system by its direct fallback.
-    pub fallback: Option<String>,
-}
-
-/// Linear-solver failures.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum LinearSolverError {
-    #[error(
-        "the system is singular{}: is a body unconstrained? a body held only by contact needs contact or springs before first load",
-        dof_text(*.dof)
-    )]
-    Singular {
-        /// Free-dof index of the offending pivot, when known.
-        dof: Option<usize>,
-    },
-    #[error("the matrix is not positive definite (non-positive pivot at free dof {dof}) and only LLT was allowed")]
-    NotPositiveDefinite { dof: usize },
-    #[error("the matrix has a non-finite value at position {index} of the values array")]
-    NonFinite { index: usize },
-    #[error("expected {expected} {what}, got {got}")]
-    Dimension { what: &'static str, expected: usize, got: usize },
-    #[error("{0} called before {1}")]
-    Order(&'static str, &'static str),
-    #[error("iterative solver did not converge: {iterations} iterations, relative residual {relative_residual:e}")]
-    DidNotConverge { iterations: usize, relative_residual: f64 },
-    #[error("faer: {0}")]
-    Faer(String),
-    /// An external backend's failure, with its own words (PETSc names the function).
-    #[error("{0}")]
-    Backend(String),
-    /// The factorization would not fit in memory (checked after the symbolic analysis).
-    #[error("{0}")]
-    TooLarge(super::memory::TooLarge),
-}
-
-fn dof_text(dof: Option<usize>) -> String {
-    match dof {
-        Some(d) => format!(" (zero pivot at free dof {d})"),
-        None => String::new(),
-    }
-}
-
-/// The interface every linear-solver backend implements.
-pub trait LinearSolver: Send {
-    /// Short name for logs, e.g. `"faer-direct"`.
-    fn name(&self) -> &str;
-    /// Analyses a sparsity pattern (square, CSC, both triangles, sorted rows):
-    /// ordering and symbolic factorization. Call again when the pattern or the
-    /// symmetry changes; invalidates the previous factorization.
-    fn analyse(&mut self, pattern: SymbolicSparseColMatRef<'_, usize>, symmetry: Symmetry) -> Result<(), LinearSolverError>;
-    /// Numeric factorization of the matrix with these values (pattern order).
-    fn factor(&mut self, values: &[f64]) -> Result<FactorInfo, LinearSolverError>;
-    /// Overwrites `rhs` with the solution of `A x = rhs`.
-    fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolverError>;
-    /// Accumulated timings since construction.
-    fn timings(&self) -> SolverTimings;
-    /// What the last `solve_in_place` did (a direct backend: nothing to say).
-    fn last_solve(&self) -> SolveReport {
-        SolveReport::default()
-    }
-    /// The relative residual the next solves may stop at, for an iterative
-    /// backend (an inexact Newton's forcing term); a direct backend ignores it.
-    fn set_forcing(&mut self, _eta: f64) {}
-    /// The current configuration: nodal reference coordinates and the full
-    /// displacement vector, before `factor` (a multigrid backend builds its
-    /// rigid-body near-null space from them); others ignore it.
-    fn set_configuration(&mut self, _reference: &[nalgebra::Vector3<f64>], _u: &[f64]) {}
-}
+use super::error::LinearSolverError;
+use crate::solver::ordering::{nested_dissection, FillOrdering};
+use super::interface::{check_values, FactorInfo, Factorization, LinearSolver, SolverTimings, Symmetry};
 
 /// Widest supernode (columns) from which [`FaerDirect`] runs faer in parallel when
 /// its parallelism is left to it.
@@ -395,20 +265,6 @@ impl FaerDirect {
     }
 }
 
-/// The checks every `factor(values)` makes: a pattern was analysed, `values` has one
-/// finite entry per pattern entry. Returns the pattern.
-pub fn check_values<'a>(pattern: Option<&'a SymbolicSparseColMat<usize>>, values: &[f64]) -> Result<&'a SymbolicSparseColMat<usize>, LinearSolverError> {
-    let pattern = pattern.ok_or(LinearSolverError::Order("factor", "analyse"))?;
-    let nnz = pattern.row_idx().len();
-    if values.len() != nnz {
-        return Err(LinearSolverError::Dimension { what: "values (pattern entries)", expected: nnz, got: values.len() });
-    }
-    if let Some(index) = values.iter().position(|v| !v.is_finite()) {
-        return Err(LinearSolverError::NonFinite { index });
-    }
-    Ok(pattern)
-}
-
 /// Diagonal of a Cholesky-type factor in the permuted order: `L_jj` for `LLᵀ`,
 /// `D_jj` for `LDLᵀ` (both are stored on the factor's diagonal).
 fn factor_diagonal(sym: &SymbolicCholesky<usize>, values: &[f64]) -> Vec<f64> {
@@ -470,7 +326,7 @@ impl LinearSolver for FaerDirect {
                 };
                 let c = factorize_symbolic_cholesky(owned.as_ref(), Side::Lower, ordering, Default::default())
                     .map_err(|e| LinearSolverError::Faer(format!("{e:?}")))?;
-                super::memory::check_cholesky(c.len_val(), n, owned.compute_nnz()).map_err(LinearSolverError::TooLarge)?;
+                crate::solver::memory::check_cholesky(c.len_val(), n, owned.compute_nnz()).map_err(LinearSolverError::TooLarge)?;
                 Symbolic::Cholesky(c)
             }
             Symmetry::General => Symbolic::Lu(
@@ -602,272 +458,4 @@ impl FaerDirect {
 }
 
 #[cfg(test)]
-#[allow(clippy::needless_range_loop)]
-mod tests {
-    use super::*;
-    use crate::solver::bench::{elastic_cube_system, relative_residual};
-
-    use crate::fem::fd::Lcg;
-
-    /// CSC (entries where `keep(i, j)`, rows sorted) of a dense matrix.
-    fn dense_to_csc(a: &[Vec<f64>], keep: impl Fn(usize, usize) -> bool) -> (SymbolicSparseColMat<usize>, Vec<f64>) {
-        let n = a.len();
-        let (mut col_ptr, mut row_idx, mut values) = (vec![0], vec![], vec![]);
-        for j in 0..n {
-            for (i, row) in a.iter().enumerate() {
-                if keep(i, j) {
-                    row_idx.push(i);
-                    values.push(row[j]);
-                }
-            }
-            col_ptr.push(row_idx.len());
-        }
-        (SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx), values)
-    }
-
-    fn residual_of(p: &SymbolicSparseColMat<usize>, v: &[f64], x: &[f64], b: &[f64]) -> f64 {
-        relative_residual(p.col_ptr(), p.row_idx(), v, x, b)
-    }
-
-    fn solve(solver: &mut FaerDirect, p: &SymbolicSparseColMat<usize>, v: &[f64], b: &[f64], sym: Symmetry) -> (Vec<f64>, Factorization) {
-        solver.analyse(p.as_ref(), sym).unwrap();
-        let info = solver.factor(v).unwrap();
-        let mut x = b.to_vec();
-        solver.solve_in_place(&mut x).unwrap();
-        (x, info.method)
-    }
-
-    fn with(symmetric: SymmetricStrategy) -> FaerDirect {
-        FaerDirect::new(FaerDirectOptions { symmetric, ..Default::default() })
-    }
-
-    #[test]
-    fn llt_ldlt_lu_agree_on_elastic_cube() {
-        let cube = elastic_cube_system(4).unwrap();
-        let p = cube.pattern.symbolic_owned();
-        let v = cube.assembly.values();
-        let b = &cube.rhs;
-        let (x_llt, m1) = solve(&mut with(SymmetricStrategy::LltThenLdlt), p, v, b, Symmetry::Symmetric);
-        let (x_ldlt, m2) = solve(&mut with(SymmetricStrategy::Ldlt), p, v, b, Symmetry::Symmetric);
-        let (x_lu, m3) = solve(&mut FaerDirect::default(), p, v, b, Symmetry::General);
-        assert_eq!((m1, m2, m3), (Factorization::Llt, Factorization::Ldlt, Factorization::Lu));
-        for x in [&x_llt, &x_ldlt, &x_lu] {
-            let r = residual_of(p, v, x, b);
-            assert!(r < 1e-12, "residual {r:e}");
-        }
-        let norm = x_llt.iter().map(|v| v * v).sum::<f64>().sqrt();
-        for x in [&x_ldlt, &x_lu] {
-            let d = x.iter().zip(&x_llt).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt();
-            assert!(d / norm < 1e-10, "solutions differ by {:e}", d / norm);
-        }
-        // The load pushes the top face down.
-        assert!(x_llt.iter().cloned().fold(0.0, f64::min) < -1.0);
-    }
-
-    /// Quasi-definite `[[K, Bᵀ], [B, −C]]`: symmetric indefinite.
-    fn saddle_point(nk: usize, nb: usize) -> Vec<Vec<f64>> {
-        let n = nk + nb;
-        let mut rng = Lcg(3);
-        let mut a = vec![vec![0.0; n]; n];
-        for i in 0..n {
-            for j in 0..i {
-                let coupled = j < nk && ((i < nk && (i - j) <= 3) || (i >= nk && (i * 7 + j) % 5 == 0));
-                if coupled {
-                    let v = rng.uniform();
-                    a[i][j] = v;
-                    a[j][i] = v;
-                }
-            }
-        }
-        for i in 0..nk {
-            a[i][i] = 8.0 + rng.uniform();
-        }
-        for i in nk..n {
-            a[i][i] = -1e-3 * (1.5 + rng.uniform());
-        }
-        a
-    }
-
-    #[test]
-    fn symmetric_indefinite_goes_to_ldlt() {
-        let a = saddle_point(24, 8);
-        let (p, v) = dense_to_csc(&a, |i, j| i == j || a[i][j] != 0.0);
-        let b: Vec<f64> = (0..a.len()).map(|i| 1.0 + i as f64 * 0.1).collect();
-        let mut s = FaerDirect::default();
-        let (x, m) = solve(&mut s, &p, &v, &b, Symmetry::Symmetric);
-        assert_eq!(m, Factorization::Ldlt);
-        let r = residual_of(&p, &v, &x, &b);
-        assert!(r < 1e-12, "residual {r:e}");
-        // LLT alone refuses it, with the typed error.
-        let mut llt = with(SymmetricStrategy::Llt);
-        llt.analyse(p.as_ref(), Symmetry::Symmetric).unwrap();
-        assert!(matches!(llt.factor(&v), Err(LinearSolverError::NotPositiveDefinite { .. })));
-        // LU agrees.
-        let (x_lu, _) = solve(&mut FaerDirect::default(), &p, &v, &b, Symmetry::General);
-        let d = x.iter().zip(&x_lu).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
-        assert!(d < 1e-10 * x.iter().map(|v| v.abs()).fold(0.0, f64::max));
-    }
-
-    #[test]
-    fn nonsymmetric_with_lu() {
-        let n = 40;
-        let mut rng = Lcg(11);
-        let mut a = vec![vec![0.0; n]; n];
-        for (i, row) in a.iter_mut().enumerate() {
-            for (j, v) in row.iter_mut().enumerate() {
-                if i == j {
-                    *v = 0.5 * rng.uniform(); // not diagonally dominant: pivoting needed
-                } else if (i + 2 * j) % 7 == 0 || i.abs_diff(j) == 1 {
-                    *v = rng.uniform();
-                }
-            }
-        }
-        let (p, v) = dense_to_csc(&a, |i, j| i == j || a[i][j] != 0.0);
-        let b: Vec<f64> = (0..n).map(|i| (i as f64).sin() + 2.0).collect();
-        let mut s = FaerDirect::default();
-        let (x, m) = solve(&mut s, &p, &v, &b, Symmetry::General);
-        assert_eq!(m, Factorization::Lu);
-        let r = residual_of(&p, &v, &x, &b);
-        assert!(r < 1e-12, "residual {r:e}");
-    }
-
-    #[test]
-    fn symbolic_factorization_is_reused() {
-        let cube = elastic_cube_system(3).unwrap();
-        let p = cube.pattern.symbolic_owned();
-        let v1 = cube.assembly.values().to_vec();
-        // Same pattern, other values: 2 K + 0.5 I-like diagonal shift.
-        let mut v2: Vec<f64> = v1.iter().map(|v| 2.0 * v).collect();
-        for j in 0..p.nrows() {
-            let s = p.col_ptr()[j] + p.row_idx()[p.col_ptr()[j]..p.col_ptr()[j + 1]].binary_search(&j).unwrap();
-            v2[s] += 0.5;
-        }
-        for sym in [Symmetry::Symmetric, Symmetry::General] {
-            let mut s = FaerDirect::default();
-            s.analyse(p.as_ref(), sym).unwrap();
-            let mut xs = vec![];
-            for v in [&v1, &v2] {
-                s.factor(v).unwrap();
-                let mut x = cube.rhs.clone();
-                s.solve_in_place(&mut x).unwrap();
-                let r = residual_of(p, v, &x, &cube.rhs);
-                assert!(r < 1e-12, "{sym:?}: residual {r:e}");
-                xs.push(x);
-            }
-            let t = s.timings();
-            assert_eq!((t.n_symbolic, t.n_numeric, t.n_solve), (1, 2, 2));
-            assert!(t.symbolic > Duration::ZERO && t.numeric > Duration::ZERO && t.solve > Duration::ZERO);
-            // The second system is stiffer: smaller displacements.
-            let max = |x: &Vec<f64>| x.iter().map(|v| v.abs()).fold(0.0, f64::max);
-            assert!(max(&xs[1]) < 0.51 * max(&xs[0]));
-        }
-    }
-
-    #[test]
-    fn singular_matrices_give_typed_errors() {
-        // A decoupled dof with a zero diagonal: an exact zero pivot.
-        let n = 12;
-        let mut a = vec![vec![0.0; n]; n];
-        for i in 0..n {
-            a[i][i] = 4.0;
-            if i + 1 < n {
-                a[i][i + 1] = -1.0;
-                a[i + 1][i] = -1.0;
-            }
-        }
-        let dead = 7;
-        for i in 0..n {
-            a[dead][i] = 0.0;
-            a[i][dead] = 0.0;
-        }
-        let (p, v) = dense_to_csc(&a, |i, j| i == j || a[i][j] != 0.0);
-        for strategy in [SymmetricStrategy::LltThenLdlt, SymmetricStrategy::Ldlt] {
-            let mut s = with(strategy);
-            s.analyse(p.as_ref(), Symmetry::Symmetric).unwrap();
-            let err = s.factor(&v).unwrap_err();
-            assert_eq!(err, LinearSolverError::Singular { dof: Some(dead) }, "{strategy:?}");
-            assert!(err.to_string().contains("is a body unconstrained?"));
-            let mut x = vec![1.0; n];
-            assert_eq!(s.solve_in_place(&mut x), Err(LinearSolverError::Order("solve_in_place", "a successful factor")));
-        }
-        // The same on an elastic cube large enough for the supernodal path.
-        let cube = elastic_cube_system(6).unwrap();
-        let p6 = cube.pattern.symbolic_owned();
-        let mut v6 = cube.assembly.values().to_vec();
-        let dead = 100;
-        for j in 0..p6.nrows() {
-            for s in p6.col_ptr()[j]..p6.col_ptr()[j + 1] {
-                if j == dead || p6.row_idx()[s] == dead {
-                    v6[s] = 0.0;
-                }
-            }
-        }
-        for strategy in [SymmetricStrategy::LltThenLdlt, SymmetricStrategy::Ldlt] {
-            let mut s = with(strategy);
-            s.analyse(p6.as_ref(), Symmetry::Symmetric).unwrap();
-            assert!(matches!(s.symbolic, Some(Symbolic::Cholesky(ref c)) if matches!(c.raw(), SymbolicCholeskyRaw::Supernodal(_))));
-            assert_eq!(s.factor(&v6), Err(LinearSolverError::Singular { dof: Some(dead) }), "{strategy:?}");
-        }
-
-        // LU: a structurally empty column.
-        let (p, v) = dense_to_csc(&a, |i, j| a[i][j] != 0.0);
-        let mut s = FaerDirect::default();
-        s.analyse(p.as_ref(), Symmetry::General).unwrap();
-        match s.factor(&v) {
-            Err(LinearSolverError::Singular { .. }) => {}
-            other => panic!("expected Singular, got {other:?}"),
-        }
-
-        // An unconstrained elastic cube: six rigid modes, round-off pivots.
-        let (nodes, hexes) = crate::assembly::pattern::structured_hex_grid(2, 2, 2);
-        let pat = crate::assembly::Pattern::build(
-            crate::assembly::DofMap::all_free(nodes.len()).unwrap(),
-            &hexes,
-            crate::assembly::NodeGroups::new(),
-        )
-        .unwrap();
-        let mut asm = crate::assembly::Assembly::new(&pat).unwrap();
-        let (values, _) = asm
-            .assemble(&pat, |e, _r, k| {
-                let x = std::array::from_fn(|a| nodes[hexes[e][a] as usize]);
-                *k = crate::solver::bench::hex8_elastic_stiffness(&x, 1.0, 0.3).ok_or(())?;
-                Ok::<(), ()>(())
-            })
-            .unwrap();
-        let mut s = FaerDirect::default();
-        s.analyse(pat.symbolic(), Symmetry::Symmetric).unwrap();
-        match s.factor(values) {
-            Err(LinearSolverError::Singular { dof: Some(_) }) => {}
-            other => panic!("expected Singular with a dof, got {other:?}"),
-        }
-    }
-
-    #[test]
-    fn misuse_gives_errors_not_panics() {
-        let mut s = FaerDirect::default();
-        assert!(matches!(s.factor(&[1.0]), Err(LinearSolverError::Order(..))));
-        let a = vec![vec![2.0, 0.0], vec![0.0, 3.0]];
-        let (p, v) = dense_to_csc(&a, |i, j| i == j);
-        s.analyse(p.as_ref(), Symmetry::Symmetric).unwrap();
-        assert!(matches!(s.factor(&[1.0]), Err(LinearSolverError::Dimension { .. })));
-        assert_eq!(s.factor(&[1.0, f64::NAN]), Err(LinearSolverError::NonFinite { index: 1 }));
-        s.factor(&v).unwrap();
-        assert!(matches!(s.solve_in_place(&mut [1.0]), Err(LinearSolverError::Dimension { .. })));
-        let mut x = [2.0, 3.0];
-        s.solve_in_place(&mut x).unwrap();
-        assert!((x[0] - 1.0).abs() < 1e-15 && (x[1] - 1.0).abs() < 1e-15, "{x:?}");
-    }
-
-    #[test]
-    fn fixed_parallelism_is_reproducible() {
-        let cube = elastic_cube_system(6).unwrap();
-        let p = cube.pattern.symbolic_owned();
-        let run = |par: Par| {
-            let mut s = FaerDirect::new(FaerDirectOptions { par: Some(par), ..Default::default() });
-            solve(&mut s, p, cube.assembly.values(), &cube.rhs, Symmetry::Symmetric).0
-        };
-        let bits = |x: Vec<f64>| x.into_iter().map(f64::to_bits).collect::<Vec<_>>();
-        assert_eq!(bits(run(Par::Seq)), bits(run(Par::Seq)));
-        assert_eq!(bits(run(Par::rayon(2))), bits(run(Par::rayon(2))));
-    }
-}
+mod tests;

@@ -1,0 +1,163 @@
+//! The file system side of every format: reading a file or standard input,
+//! writing an output so that a failure never leaves a half-written file, and
+//! resolving a path named in a file against that file's folder.
+
+use std::fs;
+use std::io::{self, Read, Write};
+use std::path::{Path, PathBuf};
+
+use super::error::StageError;
+
+/// Read a whole file, or standard input when the path is `-`.
+pub fn read_input(path: &Path) -> io::Result<Vec<u8>> {
+    if path.as_os_str() == "-" {
+        let mut v = Vec::new();
+        io::stdin().lock().read_to_end(&mut v)?;
+        Ok(v)
+    } else {
+        fs::read(path)
+    }
+}
+
+/// Write `bytes` to `path`: a regular file (or a new one) atomically, anything
+/// else in place; see [`write_atomic_with`].
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), StageError> {
+    write_atomic_with(path, |w| w.write_all(bytes))
+}
+
+/// Where [`write_atomic_with`] puts its bytes, decided by what `path` names now.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum OutputKind {
+    /// `-`: standard output.
+    Stdout,
+    /// A regular file, or nothing yet: a temporary file beside it, renamed onto
+    /// it (`target` is the path itself, or the file a symbolic link points to, so
+    /// that the link survives).
+    Regular { target: PathBuf },
+    /// A device, a FIFO or a socket: written in place. Renaming onto it would
+    /// replace the device node with a regular file.
+    Special,
+}
+
+/// What `path` names, or a clear error: a directory is no output, and a path that
+/// cannot be inspected (a missing parent folder, no permission) is refused before
+/// anything is produced.
+pub fn output_kind(path: &Path) -> Result<OutputKind, StageError> {
+    let shown = || path.display().to_string();
+    if path.as_os_str() == "-" {
+        return Ok(OutputKind::Stdout);
+    }
+    match fs::metadata(path) {
+        Ok(m) if m.is_dir() => Err(StageError::Io {
+            path: shown(),
+            action: "write",
+            source: io::Error::new(io::ErrorKind::IsADirectory, "it is a directory (give a file name inside it)"),
+        }),
+        Ok(m) if m.is_file() => {
+            let target = if fs::symlink_metadata(path).is_ok_and(|l| l.file_type().is_symlink()) {
+                fs::canonicalize(path).map_err(|source| StageError::Io { path: shown(), action: "follow the symbolic link", source })?
+            } else {
+                path.to_path_buf()
+            };
+            Ok(OutputKind::Regular { target })
+        }
+        Ok(_) => Ok(OutputKind::Special),
+        Err(e) if e.kind() == io::ErrorKind::NotFound => Ok(OutputKind::Regular { target: path.to_path_buf() }),
+        Err(source) => Err(StageError::Io { path: shown(), action: "inspect the output path", source }),
+    }
+}
+
+/// Write what `f` produces to `path`, so that a failure never leaves a half-written
+/// regular file and never replaces what is not a regular file:
+/// - a regular file, or a path that does not exist yet: into a temporary
+///   `.<name>.<pid>.tmp` in the same folder, `fsync`ed, then renamed onto the
+///   target (an existing file survives any failure; the temporary is removed);
+/// - a device, a FIFO or a socket: opened and written in place (never created,
+///   never renamed over); a write error (a full device: ENOSPC) is returned;
+/// - `-`: standard output;
+/// - a directory: an error, before `f` runs.
+pub fn write_atomic_with(path: &Path, f: impl FnOnce(&mut dyn Write) -> io::Result<()>) -> Result<(), StageError> {
+    let shown = path.display().to_string();
+    let io_err = |action: &'static str| {
+        let shown = shown.clone();
+        move |source| StageError::Io { path: shown, action, source }
+    };
+    let target = match output_kind(path)? {
+        OutputKind::Stdout => {
+            let mut buf = Vec::new();
+            f(&mut buf).map_err(io_err("produce"))?;
+            let mut out = io::stdout().lock();
+            out.write_all(&buf).and_then(|_| out.flush()).map_err(io_err("write to standard output"))?;
+            return Ok(());
+        }
+        OutputKind::Special => {
+            let file = fs::OpenOptions::new().write(true).open(path).map_err(io_err("open for writing"))?;
+            let mut w = io::BufWriter::with_capacity(1 << 20, file);
+            return f(&mut w).and_then(|_| w.flush()).map_err(io_err("write"));
+        }
+        OutputKind::Regular { target } => target,
+    };
+    remove_stale_temporaries(&target);
+    let tmp = temp_path(&target);
+    let file = fs::File::create(&tmp).map_err(io_err("create its temporary file in the same folder"))?;
+    let result = (|| -> io::Result<()> {
+        let mut w = io::BufWriter::with_capacity(1 << 20, file);
+        f(&mut w)?;
+        let file = w.into_inner().map_err(|e| e.into_error())?;
+        file.sync_data()?;
+        Ok(())
+    })();
+    if let Err(e) = result {
+        let _ = fs::remove_file(&tmp);
+        return Err(StageError::Io { path: shown, action: "write", source: e });
+    }
+    fs::rename(&tmp, &target).map_err(|e| {
+        let _ = fs::remove_file(&tmp);
+        StageError::Io { path: shown, action: "rename the temporary file onto", source: e }
+    })
+}
+
+/// Remove the temporaries of `target` (`.name.<pid>.tmp`) that a killed writer left:
+/// those whose process no longer runs (Linux: no `/proc/<pid>`). A live writer's
+/// temporary, another program's file, or anything elsewhere is never touched.
+fn remove_stale_temporaries(target: &Path) {
+    if !Path::new("/proc/self").exists() {
+        return;
+    }
+    let Some(name) = target.file_name().map(|n| n.to_string_lossy().into_owned()) else { return };
+    let dir = match target.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let prefix = format!(".{name}.");
+    let Ok(entries) = fs::read_dir(&dir) else { return };
+    for e in entries.flatten() {
+        let file = e.file_name().to_string_lossy().into_owned();
+        let pid = file.strip_prefix(&prefix).and_then(|r| r.strip_suffix(".tmp")).and_then(|p| p.parse::<u32>().ok());
+        if let Some(pid) = pid {
+            if pid != std::process::id() && !Path::new(&format!("/proc/{pid}")).exists() {
+                let _ = fs::remove_file(e.path());
+            }
+        }
+    }
+}
+
+/// `dir/.name.<pid>.tmp` beside the target (same file system, so rename is atomic).
+pub fn temp_path(path: &Path) -> PathBuf {
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "out".into());
+    let tmp = format!(".{name}.{}.tmp", std::process::id());
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.join(tmp),
+        _ => PathBuf::from(tmp),
+    }
+}
+
+/// Resolve a path named in a file (a pipeline YAML) against that file's folder
+/// (absolute paths and `-` are kept as they are).
+pub fn resolve(base: &Path, p: &Path) -> PathBuf {
+    if p.is_absolute() || p.as_os_str() == "-" {
+        p.to_path_buf()
+    } else {
+        base.join(p)
+    }
+}

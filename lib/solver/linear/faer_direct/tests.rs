@@ -1,0 +1,271 @@
+//! The faer direct backend against dense references, its fallbacks and its
+//! singularity checks.
+
+#![allow(clippy::needless_range_loop)]
+
+use super::*;
+use crate::solver::bench::{elastic_cube_system, relative_residual};
+
+use crate::fem::fd::Lcg;
+
+/// CSC (entries where `keep(i, j)`, rows sorted) of a dense matrix.
+fn dense_to_csc(a: &[Vec<f64>], keep: impl Fn(usize, usize) -> bool) -> (SymbolicSparseColMat<usize>, Vec<f64>) {
+    let n = a.len();
+    let (mut col_ptr, mut row_idx, mut values) = (vec![0], vec![], vec![]);
+    for j in 0..n {
+        for (i, row) in a.iter().enumerate() {
+            if keep(i, j) {
+                row_idx.push(i);
+                values.push(row[j]);
+            }
+        }
+        col_ptr.push(row_idx.len());
+    }
+    (SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx), values)
+}
+
+fn residual_of(p: &SymbolicSparseColMat<usize>, v: &[f64], x: &[f64], b: &[f64]) -> f64 {
+    relative_residual(p.col_ptr(), p.row_idx(), v, x, b)
+}
+
+fn solve(solver: &mut FaerDirect, p: &SymbolicSparseColMat<usize>, v: &[f64], b: &[f64], sym: Symmetry) -> (Vec<f64>, Factorization) {
+    solver.analyse(p.as_ref(), sym).unwrap();
+    let info = solver.factor(v).unwrap();
+    let mut x = b.to_vec();
+    solver.solve_in_place(&mut x).unwrap();
+    (x, info.method)
+}
+
+fn with(symmetric: SymmetricStrategy) -> FaerDirect {
+    FaerDirect::new(FaerDirectOptions { symmetric, ..Default::default() })
+}
+
+#[test]
+fn llt_ldlt_lu_agree_on_elastic_cube() {
+    let cube = elastic_cube_system(4).unwrap();
+    let p = cube.pattern.symbolic_owned();
+    let v = cube.assembly.values();
+    let b = &cube.rhs;
+    let (x_llt, m1) = solve(&mut with(SymmetricStrategy::LltThenLdlt), p, v, b, Symmetry::Symmetric);
+    let (x_ldlt, m2) = solve(&mut with(SymmetricStrategy::Ldlt), p, v, b, Symmetry::Symmetric);
+    let (x_lu, m3) = solve(&mut FaerDirect::default(), p, v, b, Symmetry::General);
+    assert_eq!((m1, m2, m3), (Factorization::Llt, Factorization::Ldlt, Factorization::Lu));
+    for x in [&x_llt, &x_ldlt, &x_lu] {
+        let r = residual_of(p, v, x, b);
+        assert!(r < 1e-12, "residual {r:e}");
+    }
+    let norm = x_llt.iter().map(|v| v * v).sum::<f64>().sqrt();
+    for x in [&x_ldlt, &x_lu] {
+        let d = x.iter().zip(&x_llt).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt();
+        assert!(d / norm < 1e-10, "solutions differ by {:e}", d / norm);
+    }
+    // The load pushes the top face down.
+    assert!(x_llt.iter().cloned().fold(0.0, f64::min) < -1.0);
+}
+
+/// Quasi-definite `[[K, Bᵀ], [B, −C]]`: symmetric indefinite.
+fn saddle_point(nk: usize, nb: usize) -> Vec<Vec<f64>> {
+    let n = nk + nb;
+    let mut rng = Lcg(3);
+    let mut a = vec![vec![0.0; n]; n];
+    for i in 0..n {
+        for j in 0..i {
+            let coupled = j < nk && ((i < nk && (i - j) <= 3) || (i >= nk && (i * 7 + j) % 5 == 0));
+            if coupled {
+                let v = rng.uniform();
+                a[i][j] = v;
+                a[j][i] = v;
+            }
+        }
+    }
+    for i in 0..nk {
+        a[i][i] = 8.0 + rng.uniform();
+    }
+    for i in nk..n {
+        a[i][i] = -1e-3 * (1.5 + rng.uniform());
+    }
+    a
+}
+
+#[test]
+fn symmetric_indefinite_goes_to_ldlt() {
+    let a = saddle_point(24, 8);
+    let (p, v) = dense_to_csc(&a, |i, j| i == j || a[i][j] != 0.0);
+    let b: Vec<f64> = (0..a.len()).map(|i| 1.0 + i as f64 * 0.1).collect();
+    let mut s = FaerDirect::default();
+    let (x, m) = solve(&mut s, &p, &v, &b, Symmetry::Symmetric);
+    assert_eq!(m, Factorization::Ldlt);
+    let r = residual_of(&p, &v, &x, &b);
+    assert!(r < 1e-12, "residual {r:e}");
+    // LLT alone refuses it, with the typed error.
+    let mut llt = with(SymmetricStrategy::Llt);
+    llt.analyse(p.as_ref(), Symmetry::Symmetric).unwrap();
+    assert!(matches!(llt.factor(&v), Err(LinearSolverError::NotPositiveDefinite { .. })));
+    // LU agrees.
+    let (x_lu, _) = solve(&mut FaerDirect::default(), &p, &v, &b, Symmetry::General);
+    let d = x.iter().zip(&x_lu).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+    assert!(d < 1e-10 * x.iter().map(|v| v.abs()).fold(0.0, f64::max));
+}
+
+#[test]
+fn nonsymmetric_with_lu() {
+    let n = 40;
+    let mut rng = Lcg(11);
+    let mut a = vec![vec![0.0; n]; n];
+    for (i, row) in a.iter_mut().enumerate() {
+        for (j, v) in row.iter_mut().enumerate() {
+            if i == j {
+                *v = 0.5 * rng.uniform(); // not diagonally dominant: pivoting needed
+            } else if (i + 2 * j) % 7 == 0 || i.abs_diff(j) == 1 {
+                *v = rng.uniform();
+            }
+        }
+    }
+    let (p, v) = dense_to_csc(&a, |i, j| i == j || a[i][j] != 0.0);
+    let b: Vec<f64> = (0..n).map(|i| (i as f64).sin() + 2.0).collect();
+    let mut s = FaerDirect::default();
+    let (x, m) = solve(&mut s, &p, &v, &b, Symmetry::General);
+    assert_eq!(m, Factorization::Lu);
+    let r = residual_of(&p, &v, &x, &b);
+    assert!(r < 1e-12, "residual {r:e}");
+}
+
+#[test]
+fn symbolic_factorization_is_reused() {
+    let cube = elastic_cube_system(3).unwrap();
+    let p = cube.pattern.symbolic_owned();
+    let v1 = cube.assembly.values().to_vec();
+    // Same pattern, other values: 2 K + 0.5 I-like diagonal shift.
+    let mut v2: Vec<f64> = v1.iter().map(|v| 2.0 * v).collect();
+    for j in 0..p.nrows() {
+        let s = p.col_ptr()[j] + p.row_idx()[p.col_ptr()[j]..p.col_ptr()[j + 1]].binary_search(&j).unwrap();
+        v2[s] += 0.5;
+    }
+    for sym in [Symmetry::Symmetric, Symmetry::General] {
+        let mut s = FaerDirect::default();
+        s.analyse(p.as_ref(), sym).unwrap();
+        let mut xs = vec![];
+        for v in [&v1, &v2] {
+            s.factor(v).unwrap();
+            let mut x = cube.rhs.clone();
+            s.solve_in_place(&mut x).unwrap();
+            let r = residual_of(p, v, &x, &cube.rhs);
+            assert!(r < 1e-12, "{sym:?}: residual {r:e}");
+            xs.push(x);
+        }
+        let t = s.timings();
+        assert_eq!((t.n_symbolic, t.n_numeric, t.n_solve), (1, 2, 2));
+        assert!(t.symbolic > Duration::ZERO && t.numeric > Duration::ZERO && t.solve > Duration::ZERO);
+        // The second system is stiffer: smaller displacements.
+        let max = |x: &Vec<f64>| x.iter().map(|v| v.abs()).fold(0.0, f64::max);
+        assert!(max(&xs[1]) < 0.51 * max(&xs[0]));
+    }
+}
+
+#[test]
+fn singular_matrices_give_typed_errors() {
+    // A decoupled dof with a zero diagonal: an exact zero pivot.
+    let n = 12;
+    let mut a = vec![vec![0.0; n]; n];
+    for i in 0..n {
+        a[i][i] = 4.0;
+        if i + 1 < n {
+            a[i][i + 1] = -1.0;
+            a[i + 1][i] = -1.0;
+        }
+    }
+    let dead = 7;
+    for i in 0..n {
+        a[dead][i] = 0.0;
+        a[i][dead] = 0.0;
+    }
+    let (p, v) = dense_to_csc(&a, |i, j| i == j || a[i][j] != 0.0);
+    for strategy in [SymmetricStrategy::LltThenLdlt, SymmetricStrategy::Ldlt] {
+        let mut s = with(strategy);
+        s.analyse(p.as_ref(), Symmetry::Symmetric).unwrap();
+        let err = s.factor(&v).unwrap_err();
+        assert_eq!(err, LinearSolverError::Singular { dof: Some(dead) }, "{strategy:?}");
+        assert!(err.to_string().contains("is a body unconstrained?"));
+        let mut x = vec![1.0; n];
+        assert_eq!(s.solve_in_place(&mut x), Err(LinearSolverError::Order("solve_in_place", "a successful factor")));
+    }
+    // The same on an elastic cube large enough for the supernodal path.
+    let cube = elastic_cube_system(6).unwrap();
+    let p6 = cube.pattern.symbolic_owned();
+    let mut v6 = cube.assembly.values().to_vec();
+    let dead = 100;
+    for j in 0..p6.nrows() {
+        for s in p6.col_ptr()[j]..p6.col_ptr()[j + 1] {
+            if j == dead || p6.row_idx()[s] == dead {
+                v6[s] = 0.0;
+            }
+        }
+    }
+    for strategy in [SymmetricStrategy::LltThenLdlt, SymmetricStrategy::Ldlt] {
+        let mut s = with(strategy);
+        s.analyse(p6.as_ref(), Symmetry::Symmetric).unwrap();
+        assert!(matches!(s.symbolic, Some(Symbolic::Cholesky(ref c)) if matches!(c.raw(), SymbolicCholeskyRaw::Supernodal(_))));
+        assert_eq!(s.factor(&v6), Err(LinearSolverError::Singular { dof: Some(dead) }), "{strategy:?}");
+    }
+
+    // LU: a structurally empty column.
+    let (p, v) = dense_to_csc(&a, |i, j| a[i][j] != 0.0);
+    let mut s = FaerDirect::default();
+    s.analyse(p.as_ref(), Symmetry::General).unwrap();
+    match s.factor(&v) {
+        Err(LinearSolverError::Singular { .. }) => {}
+        other => panic!("expected Singular, got {other:?}"),
+    }
+
+    // An unconstrained elastic cube: six rigid modes, round-off pivots.
+    let (nodes, hexes) = crate::assembly::pattern::structured_hex_grid(2, 2, 2);
+    let pat = crate::assembly::Pattern::build(
+        crate::assembly::DofMap::all_free(nodes.len()).unwrap(),
+        &hexes,
+        crate::assembly::NodeGroups::new(),
+    )
+    .unwrap();
+    let mut asm = crate::assembly::Assembly::new(&pat).unwrap();
+    let (values, _) = asm
+        .assemble(&pat, |e, _r, k| {
+            let x = std::array::from_fn(|a| nodes[hexes[e][a] as usize]);
+            *k = crate::solver::bench::hex8_elastic_stiffness(&x, 1.0, 0.3).ok_or(())?;
+            Ok::<(), ()>(())
+        })
+        .unwrap();
+    let mut s = FaerDirect::default();
+    s.analyse(pat.symbolic(), Symmetry::Symmetric).unwrap();
+    match s.factor(values) {
+        Err(LinearSolverError::Singular { dof: Some(_) }) => {}
+        other => panic!("expected Singular with a dof, got {other:?}"),
+    }
+}
+
+#[test]
+fn misuse_gives_errors_not_panics() {
+    let mut s = FaerDirect::default();
+    assert!(matches!(s.factor(&[1.0]), Err(LinearSolverError::Order(..))));
+    let a = vec![vec![2.0, 0.0], vec![0.0, 3.0]];
+    let (p, v) = dense_to_csc(&a, |i, j| i == j);
+    s.analyse(p.as_ref(), Symmetry::Symmetric).unwrap();
+    assert!(matches!(s.factor(&[1.0]), Err(LinearSolverError::Dimension { .. })));
+    assert_eq!(s.factor(&[1.0, f64::NAN]), Err(LinearSolverError::NonFinite { index: 1 }));
+    s.factor(&v).unwrap();
+    assert!(matches!(s.solve_in_place(&mut [1.0]), Err(LinearSolverError::Dimension { .. })));
+    let mut x = [2.0, 3.0];
+    s.solve_in_place(&mut x).unwrap();
+    assert!((x[0] - 1.0).abs() < 1e-15 && (x[1] - 1.0).abs() < 1e-15, "{x:?}");
+}
+
+#[test]
+fn fixed_parallelism_is_reproducible() {
+    let cube = elastic_cube_system(6).unwrap();
+    let p = cube.pattern.symbolic_owned();
+    let run = |par: Par| {
+        let mut s = FaerDirect::new(FaerDirectOptions { par: Some(par), ..Default::default() });
+        solve(&mut s, p, cube.assembly.values(), &cube.rhs, Symmetry::Symmetric).0
+    };
+    let bits = |x: Vec<f64>| x.into_iter().map(f64::to_bits).collect::<Vec<_>>();
+    assert_eq!(bits(run(Par::Seq)), bits(run(Par::Seq)));
+    assert_eq!(bits(run(Par::rayon(2))), bits(run(Par::rayon(2))));
+}

@@ -1,0 +1,108 @@
+//! The linear-solver interface: what a backend is told (the pattern and its
+//! [`Symmetry`]), what it does (`analyse`, `factor`, `solve_in_place`) and what it
+//! reports ([`FactorInfo`], [`SolverTimings`], [`SolveReport`]).
+
+use std::time::Duration;
+
+use faer::sparse::{SymbolicSparseColMat, SymbolicSparseColMatRef};
+
+use super::error::LinearSolverError;
+
+/// Structure of the matrix, chosen by the caller (the tangent is symmetric
+/// without friction, non-symmetric with it).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Symmetry {
+    /// Symmetric; both triangles are stored, the lower one is read.
+    Symmetric,
+    /// Non-symmetric.
+    General,
+}
+
+/// The factorization actually computed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Factorization {
+    Llt,
+    Ldlt,
+    Lu,
+    /// No factorization: an algebraic-multigrid preconditioner (built or kept).
+    Multigrid,
+}
+
+/// What one `factor` call did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FactorInfo {
+    pub method: Factorization,
+    /// Wall time of this numeric factorization (including a failed `LLᵀ` before
+    /// the `LDLᵀ` fallback).
+    pub time: Duration,
+}
+
+/// Accumulated wall times, split by phase, and call counts.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct SolverTimings {
+    /// Ordering + symbolic factorization (`analyse`).
+    pub symbolic: Duration,
+    /// Numeric factorizations (`factor`).
+    pub numeric: Duration,
+    /// Triangular solves (`solve_in_place`).
+    pub solve: Duration,
+    pub n_symbolic: usize,
+    pub n_numeric: usize,
+    pub n_solve: usize,
+    /// Krylov iterations over all solves (iterative backends).
+    pub n_krylov: usize,
+    /// Solves an iterative backend handed to its direct fallback.
+    pub n_fallback: usize,
+    /// `factor` calls that kept an earlier preconditioner instead of factoring.
+    pub n_reused: usize,
+}
+
+/// What the last `solve_in_place` did, for the log.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SolveReport {
+    /// Krylov iterations (0 for a direct solve).
+    pub krylov_iterations: usize,
+    /// Why an iterative backend solved this system by its direct fallback.
+    pub fallback: Option<String>,
+}
+
+/// The interface every linear-solver backend implements.
+pub trait LinearSolver: Send {
+    /// Short name for logs, e.g. `"faer-direct"`.
+    fn name(&self) -> &str;
+    /// Analyses a sparsity pattern (square, CSC, both triangles, sorted rows):
+    /// ordering and symbolic factorization. Call again when the pattern or the
+    /// symmetry changes; invalidates the previous factorization.
+    fn analyse(&mut self, pattern: SymbolicSparseColMatRef<'_, usize>, symmetry: Symmetry) -> Result<(), LinearSolverError>;
+    /// Numeric factorization of the matrix with these values (pattern order).
+    fn factor(&mut self, values: &[f64]) -> Result<FactorInfo, LinearSolverError>;
+    /// Overwrites `rhs` with the solution of `A x = rhs`.
+    fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolverError>;
+    /// Accumulated timings since construction.
+    fn timings(&self) -> SolverTimings;
+    /// What the last `solve_in_place` did (a direct backend: nothing to say).
+    fn last_solve(&self) -> SolveReport {
+        SolveReport::default()
+    }
+    /// The relative residual the next solves may stop at, for an iterative
+    /// backend (an inexact Newton's forcing term); a direct backend ignores it.
+    fn set_forcing(&mut self, _eta: f64) {}
+    /// The current configuration: nodal reference coordinates and the full
+    /// displacement vector, before `factor` (a multigrid backend builds its
+    /// rigid-body near-null space from them); others ignore it.
+    fn set_configuration(&mut self, _reference: &[nalgebra::Vector3<f64>], _u: &[f64]) {}
+}
+
+/// The checks every `factor(values)` makes: a pattern was analysed, `values` has one
+/// finite entry per pattern entry. Returns the pattern.
+pub fn check_values<'a>(pattern: Option<&'a SymbolicSparseColMat<usize>>, values: &[f64]) -> Result<&'a SymbolicSparseColMat<usize>, LinearSolverError> {
+    let pattern = pattern.ok_or(LinearSolverError::Order("factor", "analyse"))?;
+    let nnz = pattern.row_idx().len();
+    if values.len() != nnz {
+        return Err(LinearSolverError::Dimension { what: "values (pattern entries)", expected: nnz, got: values.len() });
+    }
+    if let Some(index) = values.iter().position(|v| !v.is_finite()) {
+        return Err(LinearSolverError::NonFinite { index });
+    }
+    Ok(pattern)
+}

@@ -1,0 +1,24 @@
+//! The linear-solver interface and the faer direct backend.
+//!
+//! **One small interface.** Every backend (the sparse direct one here; the
+//! PETSc/AMG Krylov one under MPI, `solver::petsc`) implements [`LinearSolver`]:
+//! `analyse(pattern, symmetry)` once per sparsity pattern, `factor(values)` once
+//! per Newton iteration (for an iterative backend: build the preconditioner),
+//! `solve_in_place(rhs)` per right-hand side. The values are always in the CSC
+//! order of the pattern given to `analyse` (the order of
+//! [`crate::assembly::Pattern`] and [`crate::assembly::Assembly::values`]); a
+//! distributed backend would receive the locally owned columns in the same form.
+//!
+//! | file | concept |
+//! |------|---------|
+//! | [`interface`] | the [`LinearSolver`] trait and what it reports |
+//! | [`error`] | [`LinearSolverError`] |
+//! | [`faer_direct`] | the faer backend: ordering and symbolic factorization once, `LLᵀ` → `LDLᵀ` or `LU` per Newton iteration, the singularity check |
+
+pub mod error;
+pub mod faer_direct;
+pub mod interface;
+
+pub use error::LinearSolverError;
+pub use faer_direct::{FaerDirect, FaerDirectOptions, SymmetricStrategy, PARALLEL_SUPERNODE};
+pub use interface::{check_values, FactorInfo, Factorization, LinearSolver, SolveReport, SolverTimings, Symmetry};

@@ -1,0 +1,30 @@
+//! The figure as data, ready to draw: panels of labelled series of points on a
+//! shared x axis, sizes and ranges decided.
+
+/// A series ready to draw.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Series {
+    pub label: String,
+    /// (x, y) in row order.
+    pub points: Vec<(f64, f64)>,
+}
+
+/// A panel ready to draw.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Panel {
+    pub y_label: Option<String>,
+    /// The y axis (lo < hi).
+    pub y_range: (f64, f64),
+    pub series: Vec<Series>,
+}
+
+/// Everything [`render`](super::render) needs: no file names, only numbers and text.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Figure {
+    pub title: Option<String>,
+    pub x_label: String,
+    pub size: (u32, u32),
+    /// The shared x axis (lo < hi).
+    pub x_range: (f64, f64),
+    pub panels: Vec<Panel>,
+}
