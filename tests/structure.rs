@@ -44,20 +44,7 @@ const ALLOWED_UPWARD: &[(&str, &str, &str)] = &[
 
 /// Circles that stand until their cause moves: (the files, why). A circle through
 /// more files, or any other, fails.
-/// Each of them is in files under rewrite for issue 26; the cut is named.
 const ALLOWED_CIRCLES: &[(&[&str], &str)] = &[
-    (
-        &["lib/stages/mod.rs", "lib/stages/tag.rs"],
-        "StageRunError wraps TagError, and the tag stage returns StageRunError: cut when TagError leaves tag.rs",
-    ),
-    (
-        &["lib/contact/net/grid.rs", "lib/contact/net/mod.rs", "lib/contact/net/patches.rs", "lib/contact/net/periodic.rs", "lib/contact/net/surface.rs"],
-        "net/mod.rs defines ControlNet and NetError, which its children use, and calls them: cut when those types leave mod.rs",
-    ),
-    (
-        &["lib/spline/subdivision/catmull_clark.rs", "lib/spline/subdivision/mod.rs", "lib/spline/subdivision/stencil.rs", "lib/spline/subdivision/topology.rs"],
-        "subdivision/mod.rs defines QuadControlMesh and SubdivisionError, which its children use, and calls them: cut when those types leave mod.rs",
-    ),
 ];
 
 #[test]

@@ -11,6 +11,7 @@ pub mod import;
 pub mod plot;
 pub mod solve;
 pub mod tag;
+pub mod tag_error;
 
 use crate::check::CheckError;
 use crate::format::msh::MshError;
@@ -22,7 +23,7 @@ use crate::solver::restart::RestartError;
 use crate::format::stage::StageError;
 use crate::format::vtk::VtkError;
 use plot::PlotError;
-use tag::TagError;
+use tag_error::TagError;
 
 
 /// Why a stage failed. Every variant carries the file (and line, element or set)

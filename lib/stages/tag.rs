@@ -17,11 +17,11 @@ use std::path::Path;
 use serde::Deserialize;
 
 use super::StageRunError;
+pub use super::tag_error::TagError;
 use crate::contact::{master_net, MasterNet, NetChoice, NetError, NetShape};
 use crate::format::scmesh;
 use crate::format::sccontact::{ContactModel, ContactPair, MasterKind, SlaveKind};
 use crate::mesh::Mesh;
-use crate::spline::SplineError;
 
 /// Default orders of a B-spline master when none are given: [3, 3], the
 /// biquadratic patch (C¹ across knots) of the paper's examples.
@@ -51,33 +51,6 @@ pub struct PairSpec {
 #[serde(deny_unknown_fields)]
 pub struct PairsFile {
     pub pairs: Vec<PairSpec>,
-}
-
-/// Why a pair could not be built.
-#[derive(Debug, thiserror::Error)]
-pub enum TagError {
-    #[error("--pair {given:?}: {why} (expected NAME:SLAVE:MASTER, NAME:SLAVE:MASTER:KIND or NAME:SLAVE:MASTER:KIND:KA:KB with KIND bspline, patch, periodic, multipatch, subdivision or facet)")]
-    PairSyntax { given: String, why: String },
-    #[error("{path}: {message}")]
-    PairsFile { path: String, message: String },
-    #[error("no contact pairs given (use --pair or --pairs)")]
-    NoPairs,
-    #[error("pair '{0}' is defined twice")]
-    Duplicate(String),
-    #[error("pair '{pair}': slave '{slave}' is neither a node set nor a face set (node sets: {node_sets}; face sets: {face_sets})")]
-    UnknownSlave { pair: String, slave: String, node_sets: String, face_sets: String },
-    #[error("pair '{pair}': master {source}")]
-    Master { pair: String, source: NetError },
-    #[error("pair '{pair}': master '{master}' is a {net}: {source}")]
-    Orders { pair: String, master: String, net: String, source: SplineError },
-    #[error("pair '{pair}': a facet master is bilinear (orders [2, 2]); orders {orders:?} were given")]
-    FacetOrders { pair: String, orders: [usize; 2] },
-    #[error("pair '{pair}': a subdivision master is bicubic where regular (orders [4, 4]); orders {orders:?} were given")]
-    SubdivisionOrders { pair: String, orders: [usize; 2] },
-    #[error("pair '{pair}': master face set '{master}' cannot carry a Catmull–Clark surface: {why}")]
-    Subdivision { pair: String, master: String, why: String },
-    #[error("pair '{pair}': master face set '{master}' has no smooth master (a `facet` master takes any quad set):\n  one grid: {grid}\n  several grids: {patches}\n  subdivision: {subdivision}")]
-    NoSmoothMaster { pair: String, master: String, grid: String, patches: String, subdivision: String },
 }
 
 impl PairSpec {

@@ -19,7 +19,7 @@
 use std::collections::HashSet;
 
 use super::surface::{edge, Surface};
-use super::{ControlNet, NetError};
+use super::types::{ControlNet, NetError};
 
 /// Order the faces of `s` into one structured grid (see the module docs).
 pub(super) fn grid(s: &Surface) -> Result<ControlNet, NetError> {

@@ -15,7 +15,7 @@ use std::collections::BTreeSet;
 
 use super::grid::grid;
 use super::surface::{edge, Surface};
-use super::{ControlNet, NetError};
+use super::types::{ControlNet, NetError};
 
 /// The grids of `s`, in the order of their smallest face position.
 pub(super) fn patches(s: &Surface) -> Result<Vec<ControlNet>, NetError> {

@@ -11,7 +11,7 @@
 use std::collections::BTreeSet;
 
 use super::surface::{edge, Surface};
-use super::{ControlNet, NetError};
+use super::types::{ControlNet, NetError};
 
 /// Order the faces of `s` into an a × b grid closed along ξ¹.
 pub(super) fn periodic(s: &Surface) -> Result<ControlNet, NetError> {

@@ -8,7 +8,7 @@
 
 use std::collections::{BTreeMap, BTreeSet};
 
-use super::NetError;
+use super::types::NetError;
 use crate::mesh::{FaceSet, HexFace, Mesh};
 
 /// An unordered edge.

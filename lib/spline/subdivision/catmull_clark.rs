@@ -165,7 +165,9 @@ pub(super) fn canonical_stencil_mesh(n: usize) -> LocalMesh {
 pub(super) struct ValenceTables {
     /// Stencil size `2N+8`.
     pub m: usize,
-    /// `A`, row-major `m × m`: `P¹_i = Σ_j A[i m + j] P⁰_j`.
+    /// `A`, row-major `m × m`: `P¹_i = Σ_j A[i m + j] P⁰_j` (the evaluation uses its
+    /// powers below; the tests read A itself).
+    #[cfg_attr(not(test), allow(dead_code))]
     a: Vec<f64>,
     /// `R_c`, c = 1, 2, 3, row-major `16 × m`, rows in grid order `(i+1) + 4(j+1)`.
     r: [Vec<f64>; 3],

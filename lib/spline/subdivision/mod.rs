@@ -4,6 +4,7 @@
 //!
 //! | file               | concept |
 //! |--------------------|---------|
+//! | `control_mesh.rs`   | the quad control mesh and what can be wrong with it |
 //! | `topology.rs`       | edges → faces, node rings, manifold and orientation checks |
 //! | `stencil.rs`        | a face's local mesh with boundary phantoms, stencil order |
 //! | `bicubic.rs`        | the uniform bicubic B-spline patch of a regular face |
@@ -45,6 +46,7 @@
 
 mod bicubic;
 mod catmull_clark;
+mod control_mesh;
 mod stencil;
 mod topology;
 
@@ -52,6 +54,7 @@ mod topology;
 mod tests;
 
 pub use catmull_clark::subdominant_eigenvalue;
+pub use control_mesh::{QuadControlMesh, SubdivisionError};
 
 use bicubic::{row_of, Rows, N_ROWS, N_ROWS_JET, ORDERS};
 use catmull_clark::{subdivide, ValenceTables};
@@ -63,49 +66,6 @@ use super::{SurfacePoint, Vec3, MAX_NODES};
 
 /// Highest supported valence: a `2N+8` stencil fits in [`MAX_NODES`] = 36.
 pub const MAX_VALENCE: usize = (MAX_NODES - 8) / 2;
-
-/// A quad control mesh: faces list node indices `0..n_nodes`, each face's node cycle
-/// giving its outward normal by the right-hand rule (consistent orientation).
-#[derive(Debug, Clone, PartialEq)]
-pub struct QuadControlMesh {
-    pub n_nodes: usize,
-    pub faces: Vec<[u32; 4]>,
-}
-
-/// Everything that can be wrong with a control mesh for the limit surface.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum SubdivisionError {
-    #[error("face {face} names node {node}, but the mesh has {n_nodes} nodes")]
-    NodeOutOfRange { face: usize, node: u32, n_nodes: usize },
-    #[error("face {face} lists node {node} twice")]
-    RepeatedNode { face: usize, node: u32 },
-    #[error("edge {nodes:?} is shared by {} faces {faces:?} (a manifold surface has at most 2)", faces.len())]
-    NonManifoldEdge { nodes: [u32; 2], faces: Vec<usize> },
-    #[error("faces {faces:?} both traverse edge {nodes:?} in the same direction (inconsistent orientation)")]
-    InconsistentOrientation { nodes: [u32; 2], faces: [usize; 2] },
-    #[error("the {faces} faces around node {node} do not form one fan (a fan of {fan} found): non-manifold vertex")]
-    NonManifoldVertex { node: u32, faces: usize, fan: usize },
-    #[error(
-        "boundary node {node} lies in {faces} faces: concave corners and boundary extraordinary vertices \
-         are not supported (boundary nodes must lie in 1 or 2 faces)"
-    )]
-    UnsupportedBoundaryNode { node: u32, faces: usize },
-    #[error("interior node {node} has valence {valence}; Catmull–Clark needs at least 3")]
-    ValenceTooLow { node: u32, valence: usize },
-    #[error("interior node {node} has valence {valence} above the supported {max} (2N+8 ≤ 36 nodes)")]
-    ValenceTooHigh { node: u32, valence: usize, max: usize },
-    #[error("face {face} depends on {nodes} nodes, more than the {max} a basis can hold")]
-    SupportTooLarge { face: usize, nodes: usize, max: usize },
-    #[error(
-        "the faces around the corners of face {face} do not form a Catmull–Clark stencil \
-         (a mesh too small or folded onto itself there)"
-    )]
-    StencilIncomplete { face: usize },
-    #[error("{got} control points for a mesh of {expected} nodes")]
-    ControlPointCount { got: usize, expected: usize },
-    #[error("control point {index} is not finite: {point:?}")]
-    NonFiniteControlPoint { index: usize, point: [f64; 3] },
-}
 
 /// How a face is evaluated (cost grows down the list).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

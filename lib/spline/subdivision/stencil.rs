@@ -27,7 +27,7 @@
 use std::collections::HashMap;
 
 use super::topology::Topology;
-use super::{QuadControlMesh, SubdivisionError};
+use super::control_mesh::{QuadControlMesh, SubdivisionError};
 
 /// Grid position `(i, j)` (−1…2 each, the regular patch over `[0,1]²`) of the 16
 /// stencil points of a valence-4 corner, in stencil order.

@@ -10,7 +10,7 @@
 
 use std::collections::{BTreeMap, HashMap};
 
-use super::{QuadControlMesh, SubdivisionError};
+use super::control_mesh::{QuadControlMesh, SubdivisionError};
 
 /// One node's incident faces in ring order, each with the node's corner in it.
 #[derive(Debug, Clone)]
