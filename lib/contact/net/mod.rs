@@ -31,7 +31,7 @@ pub use types::{ControlNet, MasterNet, NetChoice, NetError, NetShape, PatchNet};
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::{Body, FaceSet, HexFace};
+    use crate::mesh::{Body, FaceSet, HexFace, Mesh};
 
     /// An nx × ny × 1 block of unit hexes, one body; every hex top face (local 1,
     /// normal +z) whose (i, j) passes `keep` goes into face set "top", and the bottom

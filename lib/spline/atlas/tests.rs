@@ -12,6 +12,7 @@ fn grid_faces(na: usize, nb: usize) -> Vec<[u32; 4]> {
 
 /// Σ_k Q_k x_k = x̄, Σ Q_{k,α} x_k = ā_α, Σ Q_{k,αβ} x_k = ā_{α,β}: the basis is
 /// numbered and scaled like the geometry.
+#[allow(clippy::needless_range_loop)] // α, β are the tensor indices
 fn basis_reproduces_geometry(sp: &SurfacePoint, x: &[Vec3]) {
     let b = &sp.basis;
     let mut p = Vec3::zeros();

@@ -20,6 +20,7 @@ struct Node {
 }
 
 impl Node {
+    #[allow(clippy::needless_range_loop)] // c is the coordinate index of three arrays
     fn dist2(&self, p: &[f64; 3]) -> f64 {
         let mut d2 = 0.0;
         for c in 0..3 {
