@@ -7,6 +7,7 @@ mod paper_examples;
 mod ironing;
 mod shallow_ironing;
 mod sliding;
+mod tube;
 mod ccx_compare;
 mod crash;
 mod determinism;
