@@ -56,19 +56,7 @@ impl KnotVector {
         knots.extend((1..m).map(|s| s as f64 / m as f64));
         knots.extend(std::iter::repeat_n(1.0, order));
         debug_assert_eq!(knots.len(), n + order);
-        let p = order - 1;
-        let inv_diff = (0..m)
-            .map(|s| {
-                let span = p + s;
-                let mut t = [[0.0; MAX_ORDER]; MAX_ORDER];
-                for (j, row) in t.iter_mut().enumerate().take(p + 1).skip(1) {
-                    for (r, v) in row.iter_mut().enumerate().take(j) {
-                        *v = 1.0 / (knots[span + r + 1] - knots[span + 1 + r - j]);
-                    }
-                }
-                t
-            })
-            .collect();
+        let inv_diff = inv_diffs(&knots, order, m);
         Ok(Self { n, order, knots, inv_diff })
     }
 
@@ -88,18 +76,7 @@ impl KnotVector {
         let p = order - 1;
         let n_basis = n + p;
         let knots: Vec<f64> = (0..n_basis + order).map(|j| (j as f64 - p as f64) / n as f64).collect();
-        let inv_diff = (0..n)
-            .map(|s| {
-                let span = p + s;
-                let mut t = [[0.0; MAX_ORDER]; MAX_ORDER];
-                for (j, row) in t.iter_mut().enumerate().take(p + 1).skip(1) {
-                    for (r, v) in row.iter_mut().enumerate().take(j) {
-                        *v = 1.0 / (knots[span + r + 1] - knots[span + 1 + r - j]);
-                    }
-                }
-                t
-            })
-            .collect();
+        let inv_diff = inv_diffs(&knots, order, n);
         Ok(Self { n: n_basis, order, knots, inv_diff })
     }
 
@@ -167,6 +144,23 @@ impl KnotVector {
     pub fn first_basis(&self, s: usize) -> usize {
         s
     }
+}
+
+/// The reciprocal knot differences of each of `spans` spans (see `inv_diff`).
+fn inv_diffs(knots: &[f64], order: usize, spans: usize) -> Vec<[[f64; MAX_ORDER]; MAX_ORDER]> {
+    let p = order - 1;
+    (0..spans)
+        .map(|s| {
+            let span = p + s;
+            let mut t = [[0.0; MAX_ORDER]; MAX_ORDER];
+            for (j, row) in t.iter_mut().enumerate().take(p + 1).skip(1) {
+                for (r, v) in row.iter_mut().enumerate().take(j) {
+                    *v = 1.0 / (knots[span + r + 1] - knots[span + 1 + r - j]);
+                }
+            }
+            t
+        })
+        .collect()
 }
 
 #[cfg(test)]

@@ -337,27 +337,37 @@ pub fn master_surface_grid(p: &ContactPair, x: &[Vec3]) -> Result<vtk::Grid, Sta
     let (mut normal, mut xis) = (Vec::new(), Vec::new());
     for sj in 0..spans[1] {
         for si in 0..spans[0] {
-            let base = g.points.len() as u32;
-            for v in 0..=s {
-                for u in 0..=s {
-                    let xi = [(si as f64 + u as f64 / s as f64) / spans[0] as f64, (sj as f64 + v as f64 / s as f64) / spans[1] as f64];
-                    let sp = eval([si, sj], xi);
-                    g.points.push([sp.x_bar.x, sp.x_bar.y, sp.x_bar.z]);
-                    normal.extend([sp.n_bar.x, sp.n_bar.y, sp.n_bar.z]);
-                    xis.extend([xi[0], xi[1], 0.0]);
-                }
-            }
-            let id = |u: usize, v: usize| base + (u + (s + 1) * v) as u32;
-            for v in 0..s {
-                for u in 0..s {
-                    g.push_cell(vtk::CellKind::Quad, &[id(u, v), id(u + 1, v), id(u + 1, v + 1), id(u, v + 1)]);
-                }
-            }
+            push_piece(&mut g, &mut normal, &mut xis, |u, v| {
+                let xi = [(si as f64 + u as f64 / s as f64) / spans[0] as f64, (sj as f64 + v as f64 / s as f64) / spans[1] as f64];
+                (xi, eval([si, sj], xi))
+            });
         }
     }
     g.point_data.push(vtk::Field::vector_f64("normal", normal));
     g.point_data.push(vtk::Field::vector_f64("xi", xis));
     Ok(g)
+}
+
+/// One piece of a master surface (a knot span, a facet, a chart) as
+/// ([`SUBDIVISIONS`] + 1)² points and [`SUBDIVISIONS`]² quads; `at(u, v)` gives the
+/// parameter and the surface point of sample (u, v).
+fn push_piece(g: &mut vtk::Grid, normal: &mut Vec<f64>, xis: &mut Vec<f64>, at: impl Fn(usize, usize) -> ([f64; 2], SurfacePoint)) {
+    let s = SUBDIVISIONS;
+    let base = g.points.len() as u32;
+    for v in 0..=s {
+        for u in 0..=s {
+            let (xi, sp) = at(u, v);
+            g.points.push([sp.x_bar.x, sp.x_bar.y, sp.x_bar.z]);
+            normal.extend([sp.n_bar.x, sp.n_bar.y, sp.n_bar.z]);
+            xis.extend([xi[0], xi[1], 0.0]);
+        }
+    }
+    let id = |u: usize, v: usize| base + (u + (s + 1) * v) as u32;
+    for v in 0..s {
+        for u in 0..s {
+            g.push_cell(vtk::CellKind::Quad, &[id(u, v), id(u + 1, v), id(u + 1, v + 1), id(u, v + 1)]);
+        }
+    }
 }
 
 /// A master of many charts (closed, multi-patch, free quads): [`SUBDIVISIONS`]² quads
@@ -372,23 +382,11 @@ fn atlas_surface_grid(p: &ContactPair, x: &[Vec3]) -> Result<vtk::Grid, StageRun
     let mut g = vtk::Grid::default();
     let (mut normal, mut xis, mut charts) = (Vec::new(), Vec::new(), Vec::new());
     for c in 0..atlas.atlas().n_charts() {
-        let base = g.points.len() as u32;
-        for v in 0..=s {
-            for u in 0..=s {
-                let uv = [u as f64 / s as f64, v as f64 / s as f64];
-                let sp = atlas.evaluate(c, uv);
-                g.points.push([sp.x_bar.x, sp.x_bar.y, sp.x_bar.z]);
-                normal.extend([sp.n_bar.x, sp.n_bar.y, sp.n_bar.z]);
-                xis.extend([uv[0], uv[1], 0.0]);
-            }
-        }
-        let id = |u: usize, v: usize| base + (u + (s + 1) * v) as u32;
-        for v in 0..s {
-            for u in 0..s {
-                g.push_cell(vtk::CellKind::Quad, &[id(u, v), id(u + 1, v), id(u + 1, v + 1), id(u, v + 1)]);
-                charts.push(c as i32);
-            }
-        }
+        push_piece(&mut g, &mut normal, &mut xis, |u, v| {
+            let uv = [u as f64 / s as f64, v as f64 / s as f64];
+            (uv, atlas.evaluate(c, uv))
+        });
+        charts.extend(std::iter::repeat_n(c as i32, s * s));
     }
     g.point_data.push(vtk::Field::vector_f64("normal", normal));
     g.point_data.push(vtk::Field::vector_f64("xi", xis));
