@@ -118,6 +118,14 @@ impl Projector {
         (xi, [t.dot(&new.a_alpha[0]), t.dot(&new.a_alpha[1])])
     }
 
+    /// Charts of an atlas (1 for other masters).
+    pub fn n_charts(&self) -> usize {
+        match self {
+            Self::Atlas(p) => p.atlas().n_charts(),
+            _ => 1,
+        }
+    }
+
     /// Whether the master is an atlas (its `cell` is `[chart, 0]`).
     pub fn is_atlas(&self) -> bool {
         matches!(self, Self::Atlas(_))

@@ -530,6 +530,12 @@ impl PairSolver {
         self.usable(s) && self.trial(s) < 0.0
     }
 
+    /// Atlas masters: the chart of every slave's foot point (`u32::MAX`: none), as the
+    /// results file stores it for a restart; `None` on other masters.
+    pub fn charts(&self) -> Option<Vec<u32>> {
+        self.projector.is_atlas().then(|| (0..self.slaves.len()).map(|s| if self.usable(s) { self.chart(s) as u32 } else { u32::MAX }).collect())
+    }
+
     /// The atlas chart of slave `s`'s foot point (`usize::MAX` on other masters).
     fn chart(&self, s: usize) -> usize {
         if self.projector.is_atlas() {
@@ -839,7 +845,7 @@ impl PairSolver {
     ///
     /// [`CONTACT_STATE_COLUMNS`]: crate::format::scres::CONTACT_STATE_COLUMNS
     /// [`FRICTION_COLUMNS`]: crate::format::scres::FRICTION_COLUMNS
-    pub fn restore_history(&mut self, state: &[[f64; 6]], friction: &[[f64; 9]]) {
+    pub fn restore_history(&mut self, state: &[[f64; 6]], friction: &[[f64; 9]], charts: &[u32]) {
         for (s, row) in state.iter().enumerate().take(self.slaves.len()) {
             let active = row[3] == SlaveStatus::Active.code();
             self.lambda_n[s] = row[2];
@@ -849,8 +855,11 @@ impl PairSolver {
                 _ => [0.0; 2],
             };
         }
-        // the chart of each ξ̄_n is that of the first search after the restart
-        self.chart_n.fill(usize::MAX);
+        // atlas masters: the chart each ξ̄_n lies on, as stored (files without it:
+        // the chart of the first search after the restart)
+        for (s, c) in self.chart_n.iter_mut().enumerate() {
+            *c = charts.get(s).filter(|&&c| (c as usize) < self.projector.n_charts()).map_or(usize::MAX, |&c| c as usize);
+        }
         self.lambda_committed.copy_from_slice(&self.lambda_n);
         self.xi_n_committed.copy_from_slice(&self.xi_n);
         self.t_t_n_committed.copy_from_slice(&self.t_t_n);

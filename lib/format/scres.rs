@@ -161,6 +161,9 @@ pub struct Increment {
     /// Per pair, per face of its slave face set (the set's order): the mean contact
     /// pressure over the face (`post::contact_pressure`); empty for a node-set slave.
     pub face_pressure: Vec<Vec<f64>>,
+    /// Per pair whose master is an atlas (docs/theory/masters.md), per slave node: the
+    /// chart its ξ̄ in `contact` lies on (`u32::MAX`: none); empty for other pairs.
+    pub charts: Vec<Vec<u32>>,
 }
 
 impl Increment {
@@ -270,6 +273,9 @@ impl Results {
                 let v: Vec<f64> = fr.iter().flatten().copied().collect();
                 w.f64s(&format!("inc/{k}/pair/{p}/friction"), &[fr.len() as u64, 9], &v);
             }
+            for (p, c) in inc.charts.iter().enumerate().filter(|(_, c)| !c.is_empty()) {
+                w.u32s(&format!("inc/{k}/pair/{p}/chart"), &[c.len() as u64], c);
+            }
             for (p, fp) in inc.face_pressure.iter().enumerate().filter(|(_, f)| !f.is_empty()) {
                 w.f64s(&format!("inc/{k}/pair/{p}/face_pressure"), &[fp.len() as u64], fp);
             }
@@ -354,7 +360,20 @@ impl Results {
                 }
                 face_pressure.push(v.to_vec());
             }
-            increments.push(Increment { info, u: u.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(), stress, contact, friction, face_pressure });
+            let mut charts = Vec::with_capacity(pairs.len());
+            for (p, pair) in pairs.iter().enumerate() {
+                let name = format!("inc/{k}/pair/{p}/chart");
+                if f.array(&name).is_none() {
+                    charts.push(Vec::new());
+                    continue;
+                }
+                let v = f.u32s(&name, None)?;
+                if v.len() != pair.slave_nodes.len() {
+                    return Err(f.invalid(&name, format!("expected one chart per slave node of pair '{}' ({})", pair.name, pair.slave_nodes.len())));
+                }
+                charts.push(v.to_vec());
+            }
+            increments.push(Increment { info, u: u.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(), stress, contact, friction, face_pressure, charts });
         }
         Ok(Self { mesh, source: meta.source, setup: meta.setup, status, increments, pairs, restart: meta.restart, tail: f.tail.clone() })
     }

@@ -144,15 +144,18 @@ fn worst_element(p: &Problem, results: &Results, failure: &IncrementFailure, tri
 
 /// Each pair's summary and per-slave state at the converged increment (states
 /// updated by the Uzawa loop).
-/// Per pair: the summary, the state rows and the friction rows.
-type ContactResults = (Vec<PairSummary>, Vec<Vec<[f64; 6]>>, Vec<Vec<[f64; 9]>>);
+/// Per pair: the summary, the state rows, the friction rows and (atlas masters) the
+/// chart of each foot point.
+type ContactResults = (Vec<PairSummary>, Vec<Vec<[f64; 6]>>, Vec<Vec<[f64; 9]>>, Vec<Vec<u32>>);
 
 fn contact_results(newton: &Newton, u: &[f64]) -> ContactResults {
     let stabilization = newton.stabilization_forces(u);
     let mut summaries = Vec::with_capacity(newton.contact.len());
     let mut states = Vec::with_capacity(newton.contact.len());
     let mut friction = Vec::with_capacity(newton.contact.len());
+    let mut charts = Vec::with_capacity(newton.contact.len());
     for (k, c) in newton.contact.iter().enumerate() {
+        charts.push(c.charts().unwrap_or_default());
         let f = c.total_force();
         let max_penetration = c.max_penetration();
         let elastic_slip = c.max_elastic_slip();
@@ -197,7 +200,7 @@ fn contact_results(newton: &Newton, u: &[f64]) -> ContactResults {
                 .collect(),
         );
     }
-    (summaries, states, friction)
+    (summaries, states, friction, charts)
 }
 
 /// Run all increments; `results` holds the mesh and setup and receives the increments.
@@ -259,7 +262,7 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
                     };
                     summary.iterations += conv.iterations.len().saturating_sub(1);
                     let reactions = newton.reactions().into_iter().map(|(set, force)| Reaction { set, force }).collect();
-                    let (summaries, states, friction) = contact_results(newton, &u);
+                    let (summaries, states, friction, charts) = contact_results(newton, &u);
                     for c in &newton.contact {
                         if let (n, Some(node)) = c.failed_projections() {
                             log.warning(&format!(
@@ -319,13 +322,14 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
                         contact: states,
                         friction,
                         face_pressure,
+                        charts,
                     });
                     write(&mut file, results, out, log)?;
                     if !out.writer {
                         // nor does it keep the history's arrays (0.2 GB an increment at
                         // 1M dofs); the count and the summaries stay
                         if let Some(old) = results.increments.len().checked_sub(2).and_then(|i| results.increments.get_mut(i)) {
-                            (old.u, old.contact, old.friction, old.face_pressure) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+                            (old.u, old.contact, old.friction, old.face_pressure, old.charts) = (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
                         }
                     }
                     summary.increments += 1;

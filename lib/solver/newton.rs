@@ -396,7 +396,8 @@ impl<'p> Newton<'p> {
         for (p, pair) in self.contact.iter_mut().enumerate() {
             let state = last.contact.get(p).map_or(&[][..], |s| &s[..]);
             let friction = last.friction.get(p).map_or(&[][..], |f| &f[..]);
-            pair.restore_history(state, friction);
+            let charts = last.charts.get(p).map_or(&[][..], |c| &c[..]);
+            pair.restore_history(state, friction, charts);
         }
         self.contact_search(&last.displacements(), 0)
     }

@@ -110,6 +110,7 @@ pub fn write_results_pvd(results: &Results, output: &Path) -> Result<String, Sta
         contact: vec![],
         friction: vec![],
         face_pressure: vec![],
+        charts: vec![],
     };
     // friction fields in every step when any increment carries them
     let frictional = results.increments.iter().any(|i| i.friction.iter().any(|f| !f.is_empty()));

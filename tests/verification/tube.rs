@@ -85,6 +85,17 @@ fn a_block_slides_over_the_periodic_seam_of_a_tube() {
             assert_eq!(shape, "24 × 3 grid closed along ξ¹", "sc-tag's reading of the tube");
         }
         let res = run_contact(&mesh, &[pair(kind, orders, "block_x0", "tube_outer")], &setup());
+        // both masters are atlases (the tube is no open grid): the results file keeps
+        // the chart of every active slave's foot point, which a restart reads back
+        let last = res.increments.last().expect("increments");
+        let charts = &last.charts[0];
+        assert_eq!(charts.len(), model.pairs[0].slave_nodes.len(), "{kind:?}: charts in the results");
+        let n_charts = if kind == MasterKind::Bspline { 24 * 2 } else { 48 };
+        for (s, row) in last.contact[0].iter().enumerate() {
+            if row[3] == 1.0 {
+                assert!((charts[s] as usize) < n_charts, "{kind:?}: slave {s} active on chart {}", charts[s]);
+            }
+        }
         // the sliding phase: the normal (x) force on the block and the active nodes
         let mut fx = Vec::new();
         let mut travel = Vec::new();
