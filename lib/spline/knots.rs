@@ -41,15 +41,7 @@ impl KnotVector {
     /// Builds the open uniform knot vector (eq. 5.1) for `n` control points and
     /// order `k` (≥ 2, ≤ [`MAX_ORDER`], `n ≥ k`).
     pub fn open_uniform(n: usize, order: usize) -> Result<Self, SplineError> {
-        if order < 2 {
-            return Err(SplineError::OrderTooLow { order });
-        }
-        if order > MAX_ORDER {
-            return Err(SplineError::OrderTooHigh { order, max: MAX_ORDER });
-        }
-        if n < order {
-            return Err(SplineError::TooFewControlPoints { n, order });
-        }
+        check_order(n, order)?;
         let m = n - order + 1;
         let mut knots = Vec::with_capacity(n + order);
         knots.extend(std::iter::repeat_n(0.0, order));
@@ -64,15 +56,7 @@ impl KnotVector {
     /// order `k`: `n + k − 1` basis functions (the last `k − 1` are the first
     /// control points again) and `n` spans on `[0, 1]` (`n ≥ k`).
     pub fn periodic_uniform(n: usize, order: usize) -> Result<Self, SplineError> {
-        if order < 2 {
-            return Err(SplineError::OrderTooLow { order });
-        }
-        if order > MAX_ORDER {
-            return Err(SplineError::OrderTooHigh { order, max: MAX_ORDER });
-        }
-        if n < order {
-            return Err(SplineError::TooFewControlPoints { n, order });
-        }
+        check_order(n, order)?;
         let p = order - 1;
         let n_basis = n + p;
         let knots: Vec<f64> = (0..n_basis + order).map(|j| (j as f64 - p as f64) / n as f64).collect();
@@ -144,6 +128,20 @@ impl KnotVector {
     pub fn first_basis(&self, s: usize) -> usize {
         s
     }
+}
+
+/// Order 2 … [`MAX_ORDER`], and at least `order` control points.
+fn check_order(n: usize, order: usize) -> Result<(), SplineError> {
+    if order < 2 {
+        return Err(SplineError::OrderTooLow { order });
+    }
+    if order > MAX_ORDER {
+        return Err(SplineError::OrderTooHigh { order, max: MAX_ORDER });
+    }
+    if n < order {
+        return Err(SplineError::TooFewControlPoints { n, order });
+    }
+    Ok(())
 }
 
 /// The reciprocal knot differences of each of `spans` spans (see `inv_diff`).
