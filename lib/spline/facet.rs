@@ -21,7 +21,7 @@
 use rayon::prelude::*;
 
 use super::patch::Jet;
-use super::projection::{finish, newton, NewtonResult, Projection, ProjectionOptions};
+use super::closest_point::{finish, newton, NewtonResult, Projection, ProjectionOptions};
 use super::{KnotVector, SpanTree, SplineError, SurfacePoint, Vec3};
 
 /// Bilinear facets over an `na × nb` net (control points `i + na·j`).

@@ -11,6 +11,7 @@
 //! | [`patch`]       | tensor-product patch: x̄, ā_α, ā_{α,β}, ā_{α,βγ}, n̄, ā_αβ, b̄_αβ, Q_{a/b} (eqs. 4.11–4.13, 5.2, 6.3) |
 //! | [`facet`]       | the same control net read as bilinear 4-node facets (for comparison) |
 //! | [`span_tree`]   | AABB hierarchy over knot spans / facet cells, refittable |
+//! | [`closest_point`] | the box-constrained Newton iteration of eq. 2.2 on one smooth map, the outside test |
 //! | [`projection`]  | closest-point projection, eq. 2.2 (global search + box-constrained Newton) |
 //! | [`subdivision`] | Catmull–Clark limit surface of any manifold quad control mesh (exact evaluation, basis) |
 //! | [`atlas`]       | a master of many charts: periodic and multi-patch B-splines, subdivision faces, facets on any quad surface |
@@ -36,6 +37,7 @@
 
 pub mod atlas;
 pub mod basis;
+pub mod closest_point;
 pub mod facet;
 pub mod knots;
 pub mod patch;

@@ -20,7 +20,7 @@
 
 use rayon::prelude::*;
 
-use super::super::projection::{newton, NewtonResult};
+use super::super::closest_point::{newton, NewtonResult};
 use super::super::{Projection, ProjectionOptions, SplineError, SurfacePoint, Vec3};
 use super::tree::ChartTree;
 use super::{Atlas, EdgeKind};
