@@ -233,9 +233,7 @@ pub fn default_penalty(mesh: &Mesh, pair: &ContactPair, materials: &[MaterialMod
 fn mean_net_edge(mesh: &Mesh, pair: &ContactPair) -> f64 {
     let Some(grid) = pair.net.grid() else {
         // any other net: the mean over its distinct cell edges
-        let mut edges: Vec<(u32, u32)> = pair.net.cells().iter().flat_map(|q| (0..4).map(move |c| (q[c].min(q[(c + 1) % 4]), q[c].max(q[(c + 1) % 4])))).collect();
-        edges.sort_unstable();
-        edges.dedup();
+        let edges = pair.net.edges();
         let x = |k: u32| Vector3::from(mesh.nodes[pair.net.nodes[k as usize] as usize]);
         let sum: f64 = edges.iter().map(|&(u, v)| (x(u) - x(v)).norm()).sum();
         return if edges.is_empty() { 1.0 } else { sum / edges.len() as f64 };

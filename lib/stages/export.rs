@@ -407,9 +407,7 @@ pub fn control_net_grid(p: &ContactPair, x: &[Vec3], mesh: &crate::mesh::Mesh) -
     };
     let Some(grid) = p.net.grid() else {
         let mut g = vtk::Grid { points: x.iter().map(|v| [v.x, v.y, v.z]).collect(), ..Default::default() };
-        let mut edges: Vec<(u32, u32)> = p.net.cells().iter().flat_map(|q| (0..4).map(move |c| (q[c].min(q[(c + 1) % 4]), q[c].max(q[(c + 1) % 4])))).collect();
-        edges.sort_unstable();
-        edges.dedup();
+        let edges = p.net.edges();
         for (u, v) in edges {
             g.push_cell(vtk::CellKind::Line, &[u, v]);
         }

@@ -91,6 +91,15 @@ impl MasterNet {
         }
     }
 
+    /// Every edge of the net's cells once, as (smaller, larger) positions in
+    /// [`Self::nodes`], sorted.
+    pub fn edges(&self) -> Vec<(u32, u32)> {
+        let mut edges: Vec<(u32, u32)> = self.cells().iter().flat_map(|q| (0..4).map(move |c| (q[c].min(q[(c + 1) % 4]), q[c].max(q[(c + 1) % 4])))).collect();
+        edges.sort_unstable();
+        edges.dedup();
+        edges
+    }
+
     /// "6 × 4 grid", "32 × 5 closed grid", "3 grids (4 × 4, 4 × 4, 4 × 4)", "118 quads".
     pub fn describe(&self) -> String {
         match &self.shape {
