@@ -95,7 +95,7 @@ fn check(name: &str, mut atlas: Atlas, x: &[Vec3], chart: usize, uv0: [f64; 2]) 
 }
 
 /// A wavy tube: `na` nodes around (radius 3), `nb` rings.
-fn tube(na: usize, nb: usize) -> Vec<Vec3> {
+pub(crate) fn tube(na: usize, nb: usize) -> Vec<Vec3> {
     (0..na * nb)
         .map(|k| {
             let (i, j) = ((k % na) as f64, (k / na) as f64);
@@ -122,7 +122,7 @@ fn periodic_patch_at_its_seam() {
 
 /// An "umbrella" of `valence` sectors of m × m quads around node 0 (an extraordinary
 /// node of that valence), open boundary, gently curved.
-fn umbrella(valence: usize, m: usize) -> (Vec<Vec3>, Vec<[u32; 4]>) {
+pub(crate) fn umbrella(valence: usize, m: usize) -> (Vec<Vec3>, Vec<[u32; 4]>) {
     let mut x = vec![Vec3::new(0.0, 0.0, 0.1)];
     let mut index = std::collections::HashMap::new();
     let spoke = |s: usize| {

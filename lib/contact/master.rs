@@ -126,6 +126,15 @@ impl Projector {
         }
     }
 
+    /// Whether the master is made of bilinear facets (a facet grid or a facet atlas).
+    pub fn is_facets(&self) -> bool {
+        match self {
+            Self::Facet(_) => true,
+            Self::Atlas(p) => p.atlas().is_facets(),
+            Self::BSpline(_) => false,
+        }
+    }
+
     /// Whether the master is an atlas (its `cell` is `[chart, 0]`).
     pub fn is_atlas(&self) -> bool {
         matches!(self, Self::Atlas(_))

@@ -27,7 +27,7 @@ pub use super::settings::PairSettings;
 use super::settings::{Enforcement, Integration};
 use super::master::Projector;
 use super::mortar::element::{mortar_contact, NodeFriction};
-use super::mortar::{Mortar, MortarError};
+use super::mortar::{Feet, Mortar, MortarError};
 use crate::spline::{Projection, SplineError, SurfacePoint, Vec3};
 
 /// Where a slave node stands after the last search / state update.
@@ -94,8 +94,6 @@ pub enum PairError {
     Master { pair: String, source: SplineError },
     #[error("contact pair '{pair}': {source}")]
     Mortar { pair: String, source: MortarError },
-    #[error("contact pair '{pair}': `integration: mortar` needs a master of one grid; this master is a {net} (use `integration: node`)")]
-    MortarNeedsGrid { pair: String, net: String },
     #[error("contact pair '{pair}': exchanging the search results between MPI ranks: {message}")]
     Exchange { pair: String, message: String },
 }
@@ -259,8 +257,7 @@ impl PairSolver {
                     &def.slave_faces,
                     &pair.slave_nodes,
                     x_ref,
-                    pair.net.grid().map(|g| [g.a, g.b]).ok_or_else(|| PairError::MortarNeedsGrid { pair: pair.name.clone(), net: pair.net.describe() })?,
-                    &pair.net.nodes,
+                    &pair.net,
                     settings.multipliers,
                     settings.transfer,
                 )
@@ -371,9 +368,9 @@ impl PairSolver {
                 });
         }
         if let Some(mortar) = self.mortar.as_mut().filter(|_| self.segmentation_held) {
-            mortar.refresh(&self.projector, &self.x_net, &self.x_slave, &self.projections, &self.points, &self.areas).map_err(|source| PairError::Master { pair: self.name.clone(), source })?;
+            mortar.refresh(&self.projector, &self.x_net, &self.x_slave, Feet { projections: &self.projections, elements: &self.cells, points: &self.points }, &self.areas).map_err(|source| PairError::Master { pair: self.name.clone(), source })?;
         } else if let Some(mortar) = &mut self.mortar {
-            mortar.integrate(&self.projector, &self.x_net, &self.x_slave, &self.projections, &self.points, &self.areas).map_err(|source| PairError::Master { pair: self.name.clone(), source })?;
+            mortar.integrate(&self.projector, &self.x_net, &self.x_slave, Feet { projections: &self.projections, elements: &self.cells, points: &self.points }, &self.areas).map_err(|source| PairError::Master { pair: self.name.clone(), source })?;
         }
         for s in 0..self.slaves.len() {
             if self.xi_n[s][0].is_nan() && self.usable(s) {

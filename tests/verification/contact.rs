@@ -41,7 +41,7 @@ pub fn pair(master_kind: MasterKind, orders: Option<[usize; 2]>, slave: &str, ma
 /// `d = σ H / E + σ / ε_N` (blocks and penalty layer in series; `H` = 1), so the
 /// pressure is `σ = d / (H/E + 1/ε_N)` at every slave node (augmented Lagrangian:
 /// `1/ε_N` → 0 as the penetration does).
-fn patch_setup(enforcement: &str, eps_n: f64, d: f64) -> String {
+pub fn patch_setup(enforcement: &str, eps_n: f64, d: f64) -> String {
     format!(
         "materials:\n  - {{body: lower, model: linear_elastic, E: 1000.0, nu: 0.3}}\n  - {{body: upper, model: linear_elastic, E: 1000.0, nu: 0.3}}\n\
          constraints:\n  - {{set: lower_x0, fix: [x]}}\n  - {{set: lower_y0, fix: [y]}}\n  - {{set: lower_z0, fix: [z]}}\n  - {{set: upper_x0, fix: [x]}}\n  - {{set: upper_y0, fix: [y]}}\n  - {{set: upper_z1, displacement: {{z: {}}}}}\n\
@@ -55,15 +55,15 @@ fn stacked(nl: usize, nu: usize) -> Mesh {
     two_bodies("lower", &block([nl, nl, 2], [1.0, 1.0, 0.5], 0.0), "upper", &block([nu, nu, 2], [1.0, 1.0, 0.5], 0.0), [0.0, 0.0, 0.5])
 }
 
-struct Patch {
+pub struct Patch {
     /// max |p_i − σ| / σ over the slave nodes
-    pointwise: f64,
+    pub pointwise: f64,
     /// |Σ p_i A_i − σ A| / (σ A)
-    total: f64,
+    pub total: f64,
     /// |Σ p_i A_i − base reaction| / (σ A)
-    equilibrium: f64,
-    augmentations: u32,
-    iterations: usize,
+    pub equilibrium: f64,
+    pub augmentations: u32,
+    pub iterations: usize,
 }
 
 fn patch(nl: usize, nu: usize, kind: MasterKind, orders: Option<[usize; 2]>, enforcement: &str) -> Patch {
@@ -74,18 +74,26 @@ fn patch_with(nl: usize, nu: usize, kind: MasterKind, orders: Option<[usize; 2]>
     let (e, eps, d) = (1000.0, 1.0e5, 1.0e-3);
     let mesh = stacked(nl, nu);
     let setup = patch_setup(enforcement, eps, d).replace("max_augmentations: 30}", &format!("max_augmentations: 30, integration: {integration}}}"));
-    let r = run_contact(&mesh, &[pair(kind, orders, "upper_z0", "lower_z1")], &setup);
     let sigma = if enforcement == "penalty" { d / (1.0 / e + 1.0 / eps) } else { d * e };
+    patch_on(&mesh, pair(kind, orders, "upper_z0", "lower_z1"), &setup, sigma, "lower_z0", 1.0)
+}
+
+/// The patch test's figures for `spec` on `mesh` under `setup`: `sigma` the exact
+/// pressure, `base` the constraint set whose reaction balances the contact force,
+/// `area` the contact area.
+pub fn patch_on(mesh: &Mesh, spec: PairSpec, setup: &str, sigma: f64, base: &str, area: f64) -> Patch {
+    let label = format!("{:?} {:?}", spec.master_kind, spec.orders);
+    let r = run_contact(mesh, &[spec], setup);
     let inc = r.increments.last().unwrap();
     let state = &inc.contact[0];
     let pressures: Vec<f64> = state.iter().map(|s| -s[1]).collect();
-    assert!(state.iter().all(|s| s[3] == 1.0), "every slave node active: {state:?}");
+    assert!(state.iter().all(|s| s[3] == 1.0), "{label}: every slave node active: {state:?}");
     let pointwise = pressures.iter().map(|p| (p - sigma).abs() / sigma).fold(0.0, f64::max);
     let summary = &inc.info.contact[0];
-    let total = (summary.force[2] - sigma).abs() / sigma;
-    let base = inc.info.reactions.iter().find(|r| r.set == "lower_z0").unwrap().force[2];
+    let total = (summary.force[2] - sigma * area).abs() / (sigma * area);
+    let base_force = inc.info.reactions.iter().find(|r| r.set == base).unwrap().force[2];
     eprintln!(
-        "patch {nl}/{nu} {kind:?} {orders:?} {enforcement}: σ = {sigma:.9}, pressures {:.9}..{:.9}, total force {:.12}, base {base:.12}, augmentations {}",
+        "patch {label}: σ = {sigma:.9}, pressures {:.9}..{:.9}, total force {:.12}, base {base_force:.12}, augmentations {}",
         pressures.iter().copied().fold(f64::INFINITY, f64::min),
         pressures.iter().copied().fold(0.0, f64::max),
         summary.force[2],
@@ -94,7 +102,7 @@ fn patch_with(nl: usize, nu: usize, kind: MasterKind, orders: Option<[usize; 2]>
     Patch {
         pointwise,
         total,
-        equilibrium: (base.abs() - summary.force[2]).abs() / sigma,
+        equilibrium: (base_force.abs() - summary.force[2]).abs() / (sigma * area),
         augmentations: summary.augmentations,
         iterations: inc.info.iterations.len(),
     }

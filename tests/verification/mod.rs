@@ -8,6 +8,7 @@ mod ironing;
 mod shallow_ironing;
 mod sliding;
 mod tube;
+mod mortar_atlas;
 mod ccx_compare;
 mod crash;
 mod determinism;

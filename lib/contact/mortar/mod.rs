@@ -30,17 +30,21 @@
 //!
 //! | file        | concept |
 //! |-------------|---------|
+//! | [`trace`]   | the master body's facets: the cells that cut the slave faces |
 //! | [`segment`] | slave face ∩ master cells, triangle quadrature |
 //! | [`element`] | the weighted gap of one slave node: residual and tangent |
 
 pub mod element;
 pub mod segment;
+pub mod trace;
 
 use rayon::prelude::*;
 
-use self::segment::{clip_convex, face_jacobian, face_point, is_convex_ccw, polygon_quadrature, quad4, ray_bilinear, signed_area2, P2, SQUARE};
+use self::segment::{clip_convex, face_jacobian, face_point, is_convex_ccw, polygon_quadrature, quad4, signed_area2, FacePlane, P2};
+use self::trace::Trace;
 use super::master::Projector;
-use crate::spline::{FacetProjector, FacetSurface, Projection, SplineError, SurfacePoint, Vec3};
+use crate::contact::MasterNet;
+use crate::spline::{Projection, SplineError, SurfacePoint, Vec3};
 
 pub use crate::contact::settings::MortarMultipliers as Multipliers;
 pub use crate::contact::settings::MortarTransfer as Transfer;
@@ -56,14 +60,27 @@ pub struct MortarPoint {
     pub n: [f64; 4],
     /// Quadrature weight in the reference configuration (area).
     pub w: f64,
-    /// The master net cell of the segment.
-    pub cell: [usize; 2],
+    /// The master net cell of the segment (a [`Trace`] cell).
+    pub cell: usize,
+    /// The master element of the foot point, as [`Projector::evaluate`] takes it:
+    /// the facet cell, the atlas chart `[chart, 0]`, or none on a single patch.
+    pub element: Option<[usize; 2]>,
     /// Foot point on the master (its parameter ξ̄).
     pub xi: [f64; 2],
     /// Foot point on the trace facet `cell` (ζ̄; = ξ̄ for a facet master).
     pub zeta: [f64; 2],
     /// Gap g = (x − x̄)·n̄ at the last integration.
     pub g: f64,
+}
+
+/// The slaves' own closest-point projections (eq. 2.2), which the integration
+/// starts from: per slave, its projection, master element (as
+/// [`Projector::project`] returns it) and surface point.
+#[derive(Clone, Copy)]
+pub struct Feet<'a> {
+    pub projections: &'a [Projection],
+    pub elements: &'a [Option<[usize; 2]>],
+    pub points: &'a [SurfacePoint],
 }
 
 /// The mortar integration of one pair.
@@ -79,13 +96,11 @@ pub struct Mortar {
     /// The faces around each slave.
     faces_of: Vec<Vec<u32>>,
     /// The trace: the master net read as facets (segmentation and δ̃g).
-    trace: FacetProjector,
-    na: usize,
-    n_cells: [usize; 2],
+    trace: Trace,
     /// Quadrature points per face (storage reused between searches).
     points: Vec<Vec<MortarPoint>>,
-    /// Facet cell of each slave node (search start of its faces).
-    node_cell: Vec<Option<[usize; 2]>>,
+    /// Trace cell of each slave node (search start of its faces).
+    node_cell: Vec<Option<usize>>,
     /// ĝ_s at the last integration.
     pub gap: Vec<f64>,
     /// ∫ N_s dA₀ over the part of the node's faces that faces the master.
@@ -114,12 +129,10 @@ pub enum MortarError {
 impl Mortar {
     /// `faces`: the slave faces as mesh node ids (cycle order); `slaves`: the pair's
     /// slave nodes (sorted); `x_ref`: reference coordinates of all mesh nodes;
-    /// `net_dims`, `net`: the master control net's size and mesh nodes.
-    pub fn new(faces: &[[u32; 4]], slaves: &[u32], x_ref: &[Vec3], net_dims: [usize; 2], net: &[u32], multipliers: Multipliers, transfer: Transfer) -> Result<Result<Self, MortarError>, SplineError> {
-        let x_net: Vec<Vec3> = net.iter().map(|&n| x_ref[n as usize]).collect();
-        let x_net = &x_net[..];
-        let trace = FacetProjector::new(FacetSurface::new(net_dims[0], net_dims[1])?, x_net)?;
-        let n_cells = trace.facets().n_cells();
+    /// `net`: the master control net (any shape).
+    pub fn new(faces: &[[u32; 4]], slaves: &[u32], x_ref: &[Vec3], net: &MasterNet, multipliers: Multipliers, transfer: Transfer) -> Result<Result<Self, MortarError>, SplineError> {
+        let x_net: Vec<Vec3> = net.nodes.iter().map(|&n| x_ref[n as usize]).collect();
+        let trace = Trace::new(net, &x_net)?;
         let mut local = Vec::with_capacity(faces.len());
         let mut faces_of = vec![Vec::new(); slaves.len()];
         for (f, nodes) in faces.iter().enumerate() {
@@ -148,8 +161,6 @@ impl Mortar {
             duals,
             faces_of,
             trace,
-            na: net_dims[0],
-            n_cells,
             points: vec![Vec::new(); faces.len()],
             node_cell: vec![None; n],
             gap: vec![f64::INFINITY; n],
@@ -157,7 +168,7 @@ impl Mortar {
             nodes: vec![Vec::new(); n],
             skipped_cells: 0,
             transfer,
-            net: net.to_vec(),
+            net: net.nodes.clone(),
             slaves: slaves.to_vec(),
         }))
     }
@@ -194,7 +205,7 @@ impl Mortar {
     }
 
     /// The trace facets at the current configuration.
-    pub fn trace(&self) -> &FacetProjector {
+    pub fn trace(&self) -> &Trace {
         &self.trace
     }
 
@@ -211,7 +222,7 @@ impl Mortar {
         for &fc in &self.faces_of[s] {
             let Some(l) = self.faces[fc as usize].iter().position(|&c| c as usize == s) else { continue };
             for p in &self.points[fc as usize] {
-                f += geometry.evaluate(p.xi, Some(p.cell)).n_bar * (p.w * self.dual_shape(fc, l, &p.n));
+                f += geometry.evaluate(p.xi, p.element).n_bar * (p.w * self.dual_shape(fc, l, &p.n));
             }
         }
         f
@@ -219,20 +230,23 @@ impl Mortar {
 
     /// Segments every slave face by the master cells over it, projects its
     /// quadrature points onto the master, and sums the weighted gaps ĝ_s. `x_net`:
-    /// the current net (already in `geometry`); `x_slave`, `foot`: the slaves'
-    /// current positions and their own projections (warm starts); `areas`: A_s.
+    /// the current net (already in `geometry`); `x_slave`: the slaves' current
+    /// positions; `feet`: their own projections (warm starts; their surface points'
+    /// basis nodes join the element, friction acting at the slave node,
+    /// `element::NodeFriction`); `areas`: A_s.
     ///
-    /// `foot_points`: the slaves' own surface points, whose basis nodes join the
-    /// element (friction acts at the slave node, `element::NodeFriction`).
-    pub fn integrate(&mut self, geometry: &Projector, x_net: &[Vec3], x_slave: &[Vec3], foot: &[Projection], foot_points: &[SurfacePoint], areas: &[f64]) -> Result<(), SplineError> {
+    /// The cells of a face are found by a walk over the trace from the cells under
+    /// its corners: a cell whose image cuts the face passes the walk on to the cells
+    /// that share a node with it (the cells under the corners always do, as a corner
+    /// on a cell edge may face the neighbouring cell). The cells that cut a convex
+    /// face are connected, so none is missed, on any quad net.
+    pub fn integrate(&mut self, geometry: &Projector, x_net: &[Vec3], x_slave: &[Vec3], feet: Feet<'_>, areas: &[f64]) -> Result<(), SplineError> {
         self.trace.update(x_net)?;
         let trace = &self.trace;
         self.node_cell.par_iter_mut().zip(x_slave.par_iter()).with_min_len(64).for_each(|(c, x)| {
-            let (p, cell) = trace.project_keeping(x, *c);
-            *c = p.converged.then_some(cell);
+            *c = trace.locate(x, *c);
         });
-        let (na, n_cells, node_cell) = (self.na, self.n_cells, &self.node_cell);
-        let square = SQUARE.map(|p| P2::new(p[0], p[1]));
+        let node_cell = &self.node_cell;
         let skipped: usize = self
             .points
             .par_iter_mut()
@@ -243,63 +257,71 @@ impl Mortar {
             .map(|(f, ((pts, face), x0))| {
                 pts.clear();
                 let xf = face.map(|s| x_slave[s as usize]);
-                let cells: Vec<[usize; 2]> = face.iter().filter_map(|&s| node_cell[s as usize]).collect();
-                if cells.is_empty() {
+                let Some(mut plane) = FacePlane::new(&xf) else { return 0 };
+                if signed_area2(&plane.corners) < 0.0 {
+                    plane.corners.reverse();
+                }
+                let mut queue: Vec<(usize, bool)> = Vec::with_capacity(16);
+                for &s in face {
+                    if let Some(c) = node_cell[s as usize] {
+                        if !queue.iter().any(|q| q.0 == c) {
+                            queue.push((c, true));
+                        }
+                    }
+                }
+                if queue.is_empty() {
                     return 0;
                 }
-                let start = face.iter().map(|&s| &foot[s as usize]).find(|p| p.converged).map(|p| p.xi);
-                let lo = [0, 1].map(|al| cells.iter().map(|c| c[al]).min().unwrap_or(0).saturating_sub(1));
-                let hi = [0, 1].map(|al| (cells.iter().map(|c| c[al]).max().unwrap_or(0) + 1).min(n_cells[al] - 1));
+                let corner = face.iter().map(|&s| s as usize).find(|&s| feet.projections[s].converged);
+                let start = Start { xi: corner.map(|s| feet.projections[s].xi), element: corner.and_then(|s| feet.elements[s]) };
                 let (mut seg, mut scratch) = (Vec::with_capacity(8), Vec::with_capacity(8));
                 let mut skipped = 0;
-                for j in lo[1]..=hi[1] {
-                    for i in lo[0]..=hi[0] {
-                        let k00 = i + na * j;
-                        let corners = [k00, k00 + 1, k00 + 1 + na, k00 + na];
-                        let (lo, hi) = trace.facets().cell_bounds([i, j]);
-                        let corner_xi = [[lo[0], lo[1]], [hi[0], lo[1]], [hi[0], hi[1]], [lo[0], hi[1]]];
-                        let mut quad = [P2::zeros(); 4];
-                        let mut met = 0;
-                        for (q, (&k, &cxi)) in quad.iter_mut().zip(corners.iter().zip(&corner_xi)) {
-                            let n = trace.evaluate_in_cell(cxi, [i, j]).n_bar;
-                            let Some(e) = ray_bilinear(&xf, &x_net[k], &n) else { break };
-                            *q = P2::new(e[0], e[1]);
-                            met += 1;
+                let mut next = 0;
+                while next < queue.len() {
+                    let (cell, seed) = queue[next];
+                    next += 1;
+                    let cuts = match segment(trace, x_net, &plane, cell, &mut seg, &mut scratch) {
+                        Segment::Cut => {
+                            // back to the face: the segment's vertices to η (module `segment`, step 4)
+                            let mut back = true;
+                            for v in seg.iter_mut() {
+                                match plane.eta(v) {
+                                    Some(eta) => *v = P2::new(eta[0], eta[1]),
+                                    None => back = false,
+                                }
+                            }
+                            if !back {
+                                skipped += 1;
+                            }
+                            polygon_quadrature(if back { &seg } else { &[] }, |eta, w| {
+                                let (xq, _) = face_point(&xf, eta);
+                                let Some(Foot { xi, element, zeta, g }) = project_point(geometry, trace, &xq, cell, start) else {
+                                    return;
+                                };
+                                let (n, _) = quad4(eta);
+                                pts.push(MortarPoint { face: f as u32, n, w: w * face_jacobian(x0, eta), cell, element, xi, zeta, g });
+                            });
+                            true
                         }
-                        if met < 4 {
-                            continue;
-                        }
-                        let a2 = signed_area2(&quad);
-                        if a2 < 0.0 {
-                            quad.reverse();
-                        }
-                        if a2.abs() < 1e-12 {
-                            continue;
-                        }
-                        if !is_convex_ccw(&quad) {
+                        Segment::NotConvex => {
                             skipped += 1;
-                            continue;
+                            false
                         }
-                        clip_convex(&square, &quad, &mut seg, &mut scratch);
-                        if seg.len() < 3 || signed_area2(&seg) < 1e-13 {
-                            continue;
+                        Segment::Empty => false,
+                    };
+                    if cuts || seed {
+                        for d in trace.neighbours(cell) {
+                            if !queue.iter().any(|q| q.0 == d) {
+                                queue.push((d, false));
+                            }
                         }
-                        let cell = [i, j];
-                        polygon_quadrature(&seg, |eta, w| {
-                            let (xq, _) = face_point(&xf, eta);
-                            let Some((xi, zeta, g)) = project_point(geometry, trace, &xq, cell, start) else {
-                                return;
-                            };
-                            let (n, _) = quad4(eta);
-                            pts.push(MortarPoint { face: f as u32, n, w: w * face_jacobian(x0, eta), cell, xi, zeta, g });
-                        });
                     }
                 }
                 skipped
             })
             .sum();
         self.skipped_cells = skipped;
-        self.gather(geometry, foot, foot_points, areas);
+        self.gather(geometry, feet, areas);
         Ok(())
     }
 
@@ -308,31 +330,30 @@ impl Mortar {
     /// `PairSolver::hold_segmentation`; the finite-difference checks use it too).
     /// `x_net` must already be in `geometry`. A point whose projection now fails is
     /// dropped.
-    pub fn refresh(&mut self, geometry: &Projector, x_net: &[Vec3], x_slave: &[Vec3], foot: &[Projection], foot_points: &[SurfacePoint], areas: &[f64]) -> Result<(), SplineError> {
+    pub fn refresh(&mut self, geometry: &Projector, x_net: &[Vec3], x_slave: &[Vec3], feet: Feet<'_>, areas: &[f64]) -> Result<(), SplineError> {
         self.trace.update(x_net)?;
         let trace = &self.trace;
         self.points.par_iter_mut().zip(self.faces.par_iter()).with_min_len(16).for_each(|(pts, face)| {
             let xf = face.map(|s| x_slave[s as usize]);
             pts.retain_mut(|p| {
                 let x: Vec3 = (0..4).map(|l| xf[l] * p.n[l]).sum();
-                match project_point(geometry, trace, &x, p.cell, Some(p.xi)) {
-                    Some((xi, zeta, g)) => {
-                        (p.xi, p.zeta, p.g) = (xi, zeta, g);
+                match project_point(geometry, trace, &x, p.cell, Start { xi: Some(p.xi), element: p.element }) {
+                    Some(Foot { xi, element, zeta, g }) => {
+                        (p.xi, p.element, p.zeta, p.g) = (xi, element, zeta, g);
                         true
                     }
                     None => false,
                 }
             });
         });
-        self.gather(geometry, foot, foot_points, areas);
+        self.gather(geometry, feet, areas);
         Ok(())
     }
 
     /// ĝ_s, the covered area and the element's nodes of every slave from the
     /// quadrature points.
-    fn gather(&mut self, geometry: &Projector, foot: &[Projection], foot_points: &[SurfacePoint], areas: &[f64]) {
-        let na = self.na;
-        let (faces, faces_of, points, net, slaves, duals, transfer) = (&self.faces, &self.faces_of, &self.points, &self.net, &self.slaves, &self.duals, self.transfer);
+    fn gather(&mut self, geometry: &Projector, feet: Feet<'_>, areas: &[f64]) {
+        let (faces, faces_of, points, net, slaves, duals, transfer, trace) = (&self.faces, &self.faces_of, &self.points, &self.net, &self.slaves, &self.duals, self.transfer, &self.trace);
         self.gap
             .par_iter_mut()
             .zip(self.covered.par_iter_mut())
@@ -349,9 +370,9 @@ impl Mortar {
                         let c = p.w * dual_shape(&duals[f as usize], l, &p.n);
                         gw += c * p.g;
                         cw += c;
-                        nodes.extend(geometry.evaluate(p.xi, Some(p.cell)).basis.nodes().iter().map(|&k| net[k]));
+                        nodes.extend(geometry.evaluate(p.xi, p.element).basis.nodes().iter().map(|&k| net[k]));
                         if transfer == Transfer::Trace {
-                            nodes.extend(cell_nodes(na, p.cell).iter().map(|&k| net[k]));
+                            nodes.extend(trace.corners(p.cell).iter().map(|&k| net[k as usize]));
                         }
                     }
                     if !points[f as usize].is_empty() {
@@ -360,8 +381,8 @@ impl Mortar {
                 }
                 if cw > 0.0 {
                     nodes.push(slaves[s]);
-                    if foot[s].converged {
-                        nodes.extend(foot_points[s].basis.nodes().iter().map(|&k| net[k]));
+                    if feet.projections[s].converged {
+                        nodes.extend(feet.points[s].basis.nodes().iter().map(|&k| net[k]));
                     }
                 }
                 nodes.sort_unstable();
@@ -404,38 +425,83 @@ fn dual_shape(a: &[[f64; 4]; 4], l: usize, n: &[f64; 4]) -> f64 {
     (0..4).map(|j| a[l][j] * n[j]).sum()
 }
 
-/// The control points `[x_00, x_10, x_01, x_11]` of net cell `cell` (the order of
-/// the facets' basis).
-pub fn cell_nodes(na: usize, cell: [usize; 2]) -> [usize; 4] {
-    let k = cell[0] + na * cell[1];
-    [k, k + 1, k + na, k + na + 1]
+/// A quadrature point's foot points: on the master (ξ̄ and its element) and on the
+/// trace facet (ζ̄), and the gap.
+struct Foot {
+    xi: [f64; 2],
+    element: Option<[usize; 2]>,
+    zeta: [f64; 2],
+    g: f64,
 }
 
-/// The foot points of a slave quadrature point `x` of the segment over `cell`: on
-/// the master (ξ̄, within `cell` for facets) and on the trace facet (ζ̄), and the gap.
-/// `None` when a projection fails or the foot point lies off the master.
-fn project_point(geometry: &Projector, trace: &FacetProjector, x: &Vec3, cell: [usize; 2], start: Option<[f64; 2]>) -> Option<([f64; 2], [f64; 2], f64)> {
-    let on_cell = |pr: &FacetProjector| {
-        let (p, c) = pr.project_on_cell(x, cell, [None, None]);
-        (p.converged && c == cell).then_some(p)
-    };
-    match geometry {
-        Projector::Facet(pr) => {
-            let p = on_cell(pr)?;
-            Some((p.xi, p.xi, p.g))
-        }
-        Projector::BSpline(pr) => {
-            let p = match start {
-                Some(xi0) => pr.project_warm(x, xi0),
-                None => pr.project(x),
-            };
-            if !(p.converged && p.inside) {
-                return None;
-            }
-            let t = on_cell(trace)?;
-            Some((p.xi, t.xi, p.g))
-        }
-        // a mortar pair needs a one-grid master (`PairError::MortarNeedsGrid`)
-        Projector::Atlas(_) => None,
+/// Where the search for a quadrature point's foot starts: a foot point of the
+/// face's corners (its parameter and master element).
+#[derive(Debug, Clone, Copy)]
+struct Start {
+    xi: Option<[f64; 2]>,
+    element: Option<[usize; 2]>,
+}
+
+/// What a master cell makes of a slave face.
+enum Segment {
+    /// The segment, a convex polygon of the face's parameter square.
+    Cut,
+    /// No area in common.
+    Empty,
+    /// The cell's image in the face is not convex (not integrated, counted).
+    NotConvex,
+}
+
+/// The segment of the slave face in `plane` under trace cell `cell`, written into
+/// `seg` in the plane's coordinates ([`segment`] module docs, steps 1–3).
+fn segment(trace: &Trace, x_net: &[Vec3], plane: &FacePlane, cell: usize, seg: &mut Vec<P2>, scratch: &mut Vec<P2>) -> Segment {
+    let corners = trace.corners(cell);
+    let mut quad = [P2::zeros(); 4];
+    for (l, q) in quad.iter_mut().enumerate() {
+        let n = trace.evaluate(trace.corner_parameter(cell, l), cell).n_bar;
+        let Some(e) = plane.meet(&x_net[corners[l] as usize], &n) else { return Segment::Empty };
+        *q = e;
     }
+    let a2 = signed_area2(&quad);
+    if a2 < 0.0 {
+        quad.reverse();
+    }
+    // areas relative to the face's (twice its area: 8 in η, where these were set)
+    let face_a2 = signed_area2(&plane.corners);
+    if a2.abs() < 1e-12 / 8.0 * face_a2 {
+        return Segment::Empty;
+    }
+    if !is_convex_ccw(&quad) {
+        // only an image over the face matters (a cell far round a curved master
+        // maps, through its tilted normals, to a twisted quad far from the square)
+        let face = &plane.corners;
+        let over = (0..2).all(|al| quad.iter().any(|q| face.iter().any(|f| q[al] > f[al])) && quad.iter().any(|q| face.iter().any(|f| q[al] < f[al])));
+        return if over { Segment::NotConvex } else { Segment::Empty };
+    }
+    clip_convex(&plane.corners, &quad, seg, scratch);
+    if seg.len() < 3 || signed_area2(seg) < 1e-13 / 8.0 * face_a2 {
+        return Segment::Empty;
+    }
+    Segment::Cut
+}
+
+/// The foot points of a slave quadrature point `x` of the segment over trace cell
+/// `cell`: on the master (ξ̄ and its element; within `cell` for facets) and on the
+/// trace facet (ζ̄), and the gap. `None` when a projection fails or the foot point
+/// lies off the master.
+fn project_point(geometry: &Projector, trace: &Trace, x: &Vec3, cell: usize, start: Start) -> Option<Foot> {
+    if geometry.is_facets() {
+        // the master is the trace itself: the point's foot on the segment's cell
+        let p = trace.project_on_cell(x, cell)?;
+        return Some(Foot { xi: p.xi, element: Some(trace.element(cell)), zeta: p.xi, g: p.g });
+    }
+    let (p, element) = match geometry {
+        Projector::BSpline(pr) => (start.xi.map_or_else(|| pr.project(x), |xi0| pr.project_warm(x, xi0)), None),
+        _ => geometry.project(x, start.element),
+    };
+    if !(p.converged && p.inside) {
+        return None;
+    }
+    let t = trace.project_on_cell(x, cell)?;
+    Some(Foot { xi: p.xi, element, zeta: t.xi, g: p.g })
 }

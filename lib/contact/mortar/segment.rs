@@ -5,21 +5,31 @@
 //! slave shape functions times the master's trace basis at the projected point, are
 //! polynomials inside one master cell and only continuous across its edges; a Gauss
 //! rule over the whole face is therefore not exact, and the patch test fails by the
-//! quadrature error. So each slave face is cut into segments, one per master cell:
+//! quadrature error. So each slave face is cut into segments, one per master cell,
+//! in the face's auxiliary plane ([`FacePlane`]: through the face's centre, normal
+//! to it there):
 //! ```text
-//! 1. the cell's four corners, carried along the cell's normal onto the slave face,
-//!    give a quadrilateral in the face's parameter square [−1, 1]² (where the
-//!    normal line through a corner meets the face: those lines bound the points
-//!    whose foot lies in the cell, so the segment edges follow the integrand's kinks
-//!    also where the faces are inclined to each other);
-//! 2. the square clipped by that quadrilateral (Sutherland–Hodgman, both convex) is
-//!    the segment, a convex polygon;
-//! 3. a fan of triangles covers it; each gets the 7-point rule of degree 5.
+//! 1. the slave face's corners are projected onto the plane: a convex quadrilateral;
+//! 2. the cell's four corners are carried along the cell's normal onto the plane
+//!    (those lines bound the points whose foot lies in the cell, so the segment
+//!    edges follow the integrand's kinks also where the faces are inclined to each
+//!    other): another quadrilateral;
+//! 3. the face clipped by the cell's image (Sutherland–Hodgman, both convex) is the
+//!    segment, a convex polygon;
+//! 4. its vertices are taken back to the face's parameter η (the projected face's
+//!    bilinear map inverted by Newton, inside the face), and a fan of triangles
+//!    covers the polygon in η; each gets the 7-point rule of degree 5, weights
+//!    times dA₀/dη.
 //! ```
-//! On flat faces with parallelogram cells the segment edges are exactly where the
-//! integrand kinks and the integrand is of degree ≤ 4 in η: the quadrature is exact.
-//! On curved surfaces the segmentation is a quadrature choice, accurate to the
-//! curvature of the cells' edges within one face.
+//! The segments of one face share their vertices, so in η they tile the square
+//! [−1, 1]² exactly, and the slave integrals (∫ Φ_s g dA₀ with g uniform, ∫ Φ_s dA₀)
+//! are exact on any flat face. On flat faces with parallelogram cells and slave
+//! faces, η is affine in the plane, the segment edges are exactly where the
+//! integrand kinks and the integrand is of degree ≤ 4: the quadrature is exact.
+//! Elsewhere (curved surfaces, cells that are not parallelograms) the segment's
+//! edges are straight in η where the cell's edges are not, a quadrature choice.
+//! Clipping in the plane, not in η, keeps the images of distant cell corners sound:
+//! the bilinear map of a skewed face, continued far beyond the face, folds over.
 
 use nalgebra::Vector2;
 
@@ -82,27 +92,77 @@ pub fn face_jacobian(x: &[Vec3; 4], eta: [f64; 2]) -> f64 {
     t[0].cross(&t[1]).norm()
 }
 
-/// The face parameter η where the line `p + t d` meets the face (Newton on
-/// x(η) − p − t d = 0 in (η¹, η², t), from the centre). `None` when it does not
-/// converge (the line parallel to the face).
-pub fn ray_bilinear(x: &[Vec3; 4], p: &Vec3, d: &Vec3) -> Option<[f64; 2]> {
-    let (mut eta, mut t) = ([0.0, 0.0], 0.0);
-    for _ in 0..30 {
-        let (q, tg) = face_point(x, eta);
-        let f = q - p - d * t;
-        let jac = nalgebra::Matrix3::from_columns(&[tg[0], tg[1], -d]);
-        let step = jac.try_inverse()? * f;
-        eta[0] -= step[0];
-        eta[1] -= step[1];
-        t -= step[2];
-        if !(eta[0].is_finite() && eta[1].is_finite()) || eta[0].abs() > 1e6 || eta[1].abs() > 1e6 {
+/// The auxiliary plane of a slave face: through its centre x(0), normal to it
+/// there, with an orthonormal frame; the face's corners projected onto it.
+#[derive(Debug, Clone, Copy)]
+pub struct FacePlane {
+    origin: Vec3,
+    normal: Vec3,
+    frame: [Vec3; 2],
+    /// The projected corners, counter-clockwise in the frame.
+    pub corners: [P2; 4],
+}
+
+impl FacePlane {
+    /// `None` for a degenerate face (zero tangents at its centre).
+    pub fn new(x: &[Vec3; 4]) -> Option<Self> {
+        let (origin, t) = face_point(x, [0.0, 0.0]);
+        let normal = t[0].cross(&t[1]).try_normalize(0.0)?;
+        let e1 = t[0].try_normalize(0.0)?;
+        let frame = [e1, normal.cross(&e1)];
+        let corners = x.map(|c| P2::new((c - origin).dot(&frame[0]), (c - origin).dot(&frame[1])));
+        Some(Self { origin, normal, frame, corners })
+    }
+
+    /// Where the line `p + t d` meets the plane; `None` when it runs (nearly)
+    /// parallel to it.
+    pub fn meet(&self, p: &Vec3, d: &Vec3) -> Option<P2> {
+        let dn = d.dot(&self.normal);
+        if dn.abs() < 1e-8 * d.norm() {
             return None;
         }
-        if step.norm() < 1e-14 * (1.0 + eta[0].abs() + eta[1].abs() + t.abs()) {
-            return Some(eta);
-        }
+        let q = p + d * ((self.origin - p).dot(&self.normal) / dn);
+        Some(P2::new((q - self.origin).dot(&self.frame[0]), (q - self.origin).dot(&self.frame[1])))
     }
-    None
+
+    /// The projected face's map η ↦ P and its Jacobian determinant.
+    fn map(&self, eta: [f64; 2]) -> (P2, nalgebra::Matrix2<f64>) {
+        let (n, d) = quad4(eta);
+        let mut p = P2::zeros();
+        let mut jac = nalgebra::Matrix2::zeros();
+        for a in 0..4 {
+            p += self.corners[a] * n[a];
+            for c in 0..2 {
+                jac[(c, 0)] += self.corners[a][c] * d[a][0];
+                jac[(c, 1)] += self.corners[a][c] * d[a][1];
+            }
+        }
+        (p, jac)
+    }
+
+    /// |dP/dη| of the projected face at η.
+    pub fn jacobian(&self, eta: [f64; 2]) -> f64 {
+        self.map(eta).1.determinant().abs()
+    }
+
+    /// The face parameter η of the plane point `p` (Newton from the centre); `None`
+    /// when it does not converge.
+    pub fn eta(&self, p: &P2) -> Option<[f64; 2]> {
+        let mut eta = [0.0, 0.0];
+        for _ in 0..30 {
+            let (q, jac) = self.map(eta);
+            let step = jac.try_inverse()? * (q - p);
+            eta[0] -= step[0];
+            eta[1] -= step[1];
+            if !(eta[0].abs() < 4.0 && eta[1].abs() < 4.0) {
+                return None;
+            }
+            if step.norm() < 1e-15 * (1.0 + eta[0].abs() + eta[1].abs()) {
+                return Some(eta);
+            }
+        }
+        None
+    }
 }
 
 /// Twice the signed area of a polygon (positive: counter-clockwise).
@@ -153,24 +213,20 @@ pub fn clip_convex(subject: &[P2], clip: &[P2], out: &mut Vec<P2>, scratch: &mut
     }
 }
 
-/// The quadrature points (η, weight in η-area) of a convex polygon: a fan of
-/// triangles from its first vertex, each with [`TRIANGLE_7`].
+/// The quadrature points (η, weight in η-area) of a polygon: a fan of triangles
+/// from its first vertex, each with [`TRIANGLE_7`] and its signed area (so a
+/// polygon that is not quite convex, a clipped segment taken back to η, is still
+/// integrated exactly for polynomials).
 pub fn polygon_quadrature(poly: &[P2], mut push: impl FnMut([f64; 2], f64)) {
     for i in 1..poly.len().saturating_sub(1) {
         let (a, b, c) = (poly[0], poly[i], poly[i + 1]);
         let area = 0.5 * cross(&(b - a), &(c - a));
-        if area <= 0.0 {
-            continue;
-        }
         for (l, w) in TRIANGLE_7 {
             let p = a * l[0] + b * l[1] + c * l[2];
             push([p.x, p.y], w * area);
         }
     }
 }
-
-/// The slave face's parameter square, counter-clockwise.
-pub const SQUARE: [[f64; 2]; 4] = [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]];
 
 #[cfg(test)]
 mod tests {
@@ -191,7 +247,7 @@ mod tests {
 
     #[test]
     fn clipping_two_squares_gives_their_overlap() {
-        let sq: Vec<P2> = SQUARE.iter().map(|p| P2::new(p[0], p[1])).collect();
+        let sq: Vec<P2> = [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]].iter().map(|p| P2::new(p[0], p[1])).collect();
         let shifted: Vec<P2> = sq.iter().map(|p| p * 0.75 + P2::new(0.6, -0.3)).collect();
         let (mut out, mut scratch) = (Vec::new(), Vec::new());
         clip_convex(&sq, &shifted, &mut out, &mut scratch);
@@ -208,18 +264,30 @@ mod tests {
     }
 
     #[test]
-    fn a_line_meets_the_face_at_its_parameter() {
-        // a warped face, lines through its points in an oblique direction (also
-        // beyond the square, where master corners lie)
-        let x = [Vec3::new(0.0, 0.0, 0.0), Vec3::new(2.0, 0.1, 0.0), Vec3::new(2.2, 1.5, 0.2), Vec3::new(-0.1, 1.2, 0.1)];
-        let d = Vec3::new(0.2, -0.1, 1.0);
-        for eta in [[0.3, -0.2], [-0.9, 0.8], [1.4, -1.3]] {
+    fn plane_points_map_back_to_the_face_parameter() {
+        // a skewed, slightly warped face: points of the face, carried along an
+        // oblique direction onto its plane, return their η (also near the corners)
+        let x = [Vec3::new(0.0, 0.0, 0.0), Vec3::new(2.0, 0.1, 0.0), Vec3::new(2.2, 1.5, 0.05), Vec3::new(-0.1, 1.2, 0.0)];
+        let plane = FacePlane::new(&x).unwrap();
+        assert!(signed_area2(&plane.corners) > 0.0, "corners counter-clockwise");
+        for eta in [[0.3, -0.2], [-0.9, 0.8], [0.99, 0.99]] {
             let (p, _) = face_point(&x, eta);
-            let back = ray_bilinear(&x, &(p + d * 0.37), &d).unwrap();
+            // the foot of p on the plane along its normal is the projected map's point
+            let q = plane.meet(&p, &plane.normal).unwrap();
+            let back = plane.eta(&q).unwrap();
+            let (pm, _) = plane.map(back);
+            assert!((pm - q).norm() < 1e-13, "{pm:?} vs {q:?}");
+            // a flat face: η itself (the warp is 0.05 at one corner: η within 5e-2)
+            assert!((back[0] - eta[0]).abs() < 5e-2 && (back[1] - eta[1]).abs() < 5e-2, "{back:?} vs {eta:?}");
+        }
+        let flat = [Vec3::new(0.0, 0.0, 0.0), Vec3::new(2.0, 0.1, 0.0), Vec3::new(2.2, 1.5, 0.0), Vec3::new(-0.1, 1.2, 0.0)];
+        let plane = FacePlane::new(&flat).unwrap();
+        for eta in [[0.3, -0.2], [-0.9, 0.8], [1.0, -1.0]] {
+            let (p, _) = face_point(&flat, eta);
+            let back = plane.eta(&plane.meet(&(p + Vec3::new(0.2, -0.1, 1.0) * 0.37), &Vec3::new(0.2, -0.1, 1.0)).unwrap()).unwrap();
             assert!((back[0] - eta[0]).abs() < 1e-12 && (back[1] - eta[1]).abs() < 1e-12, "{back:?} vs {eta:?}");
         }
-        // a line in the face's plane does not meet it in one point
-        let flat = [Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(1.0, 1.0, 0.0), Vec3::new(0.0, 1.0, 0.0)];
-        assert!(ray_bilinear(&flat, &Vec3::new(0.5, 0.5, 1.0), &Vec3::x()).is_none());
+        // a line in the plane does not meet it in one point
+        assert!(plane.meet(&Vec3::new(0.5, 0.5, 1.0), &Vec3::x()).is_none());
     }
 }
