@@ -33,4 +33,4 @@ pub mod pair;
 pub mod settings;
 pub mod tributary;
 
-pub use net::{control_net, master_net, ControlNet, MasterNet, NetChoice, NetError, NetShape, PatchNet};
+pub use net::{check_subdivision, control_net, master_net, smooth_net, ControlNet, MasterNet, NetChoice, NetError, NetShape, PatchNet, SmoothNet, SmoothNetError};
