@@ -14,7 +14,7 @@
 //! | [`dual`]      | forward-mode dual numbers, for the exact frictional tangent |
 //! | [`master`]    | the master surface behind one projection interface (B-spline or facets) |
 //! | [`mortar`]    | segment-to-segment integration of the constraint over the slave faces (`integration: mortar`) |
-//! | [`pair`]      | one pair during the solve: search, active set, Uzawa updates |
+//! | [`pair`]      | one pair during the solve: closest-point search (eq. 2.2), contact elements and active set, Uzawa updates and friction history |
 //! | [`adjust`]    | slave nodes moved onto the master before the first increment (stress-free) |
 
 pub mod adjust;
@@ -33,4 +33,4 @@ pub mod pair;
 pub mod settings;
 pub mod tributary;
 
-pub use net::{control_net, master_net, ControlNet, MasterNet, NetChoice, NetError, NetShape, PatchNet};
+pub use net::{check_subdivision, control_net, master_net, smooth_net, ControlNet, MasterNet, NetChoice, NetError, NetShape, PatchNet, SmoothNet, SmoothNetError};

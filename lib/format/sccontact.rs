@@ -108,27 +108,15 @@ impl ContactPair {
         mesh.face_set(&self.slave).map(|fs| fs.faces.iter().map(|&f| mesh.face_nodes(f)).collect())
     }
 
-    /// The knot vectors along ξ¹ and ξ² of a one-grid net: open uniform (eq. 5.1), or
-    /// periodic along ξ¹ for a closed grid; fails when an order does not fit the net
-    /// ("a 3-node row cannot carry order 4"). `None` for other shapes.
+    /// The knot vectors along ξ¹ and ξ² of a one-grid net ([`MasterNet::knot_vectors`]
+    /// at the pair's orders); `None` for other shapes.
     pub fn knot_vectors(&self) -> Result<Option<[KnotVector; 2]>, SplineError> {
-        Ok(match self.net.shape {
-            NetShape::Grid { a, b } => Some([KnotVector::open_uniform(a, self.orders[0])?, KnotVector::open_uniform(b, self.orders[1])?]),
-            NetShape::Periodic { a, b } => Some([KnotVector::periodic_uniform(a, self.orders[0])?, KnotVector::open_uniform(b, self.orders[1])?]),
-            NetShape::Patches(_) | NetShape::Quads(_) => None,
-        })
+        self.net.knot_vectors(self.orders)
     }
 
     /// Checks that the orders fit every grid of the net (each patch of a multi-patch net).
     pub fn check_orders(&self) -> Result<(), SplineError> {
-        self.knot_vectors()?;
-        if let NetShape::Patches(ps) = &self.net.shape {
-            for p in ps {
-                KnotVector::open_uniform(p.a, self.orders[0])?;
-                KnotVector::open_uniform(p.b, self.orders[1])?;
-            }
-        }
-        Ok(())
+        self.net.check_orders(self.orders)
     }
 }
 

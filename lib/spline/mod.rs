@@ -10,6 +10,7 @@
 //! | [`basis`]       | Cox–de Boor basis functions and their derivatives, eq. 5.3 |
 //! | [`patch`]       | tensor-product patch: x̄, ā_α, ā_{α,β}, ā_{α,βγ}, n̄, ā_αβ, b̄_αβ, Q_{a/b} (eqs. 4.11–4.13, 5.2, 6.3) |
 //! | [`facet`]       | the same control net read as bilinear 4-node facets (for comparison) |
+//! | [`box_tree`]    | a refittable hierarchy of boxes and its branch-and-bound walk (the global search of eq. 2.2) |
 //! | [`span_tree`]   | AABB hierarchy over knot spans / facet cells, refittable |
 //! | [`closest_point`] | the box-constrained Newton iteration of eq. 2.2 on one smooth map, the outside test |
 //! | [`projection`]  | closest-point projection, eq. 2.2 (global search + box-constrained Newton) |
@@ -37,6 +38,7 @@
 
 pub mod atlas;
 pub mod basis;
+pub mod box_tree;
 pub mod closest_point;
 pub mod facet;
 pub mod knots;

@@ -14,38 +14,27 @@
 //!
 //! [`SpanTree::query`] visits, nearest box first, every span whose box is within the
 //! current distance bound of a point; the visitor tightens the bound as it finds
-//! surface points (branch and bound).
+//! surface points (branch and bound). The boxes, their refit and the walk are
+//! [`BoxTree`]'s, shared with the charts of an atlas.
 
-use super::{KnotVector, Vec3, MAX_ORDER};
 use super::basis::basis_funs_into;
+use super::box_tree::BoxTree;
+use super::{KnotVector, Vec3, MAX_ORDER};
 
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct Node {
-    lo: [f64; 3],
-    hi: [f64; 3],
-    /// Span rectangle `[s0, s1) × [t0, t1)`.
-    s0: u32,
-    s1: u32,
-    t0: u32,
-    t1: u32,
-    /// Indices of the two children; `u32::MAX` for a leaf.
-    children: [u32; 2],
-}
+/// A rectangle of spans `[s0, s1) × [t0, t1)`.
+type Rect = [u32; 4];
 
-impl Node {
-    fn is_leaf(&self) -> bool {
-        self.children[0] == u32::MAX
-    }
-
-    /// Squared distance from `p` to the box (0 inside).
-    #[inline]
-    fn dist2(&self, p: &[f64; 3]) -> f64 {
-        let mut d2 = 0.0;
-        for ((lo, hi), p) in self.lo.iter().zip(&self.hi).zip(p) {
-            let d = (lo - p).max(0.0).max(p - hi);
-            d2 += d * d;
-        }
-        d2
+/// The two halves of a rectangle of spans, split at the middle of its longer side;
+/// `None` for a single span.
+fn halves([s0, s1, t0, t1]: Rect) -> Option<(Rect, Rect)> {
+    if s1 - s0 <= 1 && t1 - t0 <= 1 {
+        None
+    } else if s1 - s0 >= t1 - t0 {
+        let m = (s0 + s1) / 2;
+        Some(([s0, m, t0, t1], [m, s1, t0, t1]))
+    } else {
+        let m = (t0 + t1) / 2;
+        Some(([s0, s1, t0, m], [s0, s1, m, t1]))
     }
 }
 
@@ -56,7 +45,8 @@ pub struct SpanTree {
     n_spans: [usize; 2],
     window: [usize; 2],
     na: usize,
-    nodes: Vec<Node>,
+    /// The boxes; leaf item `s + ns_a·t` is span (s, t).
+    tree: BoxTree,
     /// Optional Bézier extraction per direction: `[dir][span][r][i]`, the Bézier
     /// point i of a span is `Σ_r E[r][i] B_r` (see [`Self::with_extraction`]).
     extraction: Option<[Vec<Extraction>; 2]>,
@@ -65,9 +55,6 @@ pub struct SpanTree {
 /// k×k Bézier extraction matrix of one span in one direction (`[r][i]`).
 pub type Extraction = [[f64; MAX_ORDER]; MAX_ORDER];
 
-/// Deepest hierarchy a query can walk (2⁶⁰ spans — never reached).
-const STACK: usize = 128;
-
 impl SpanTree {
     /// Topology for `n_spans` spans per direction, each spanning `window` control
     /// points per direction (the orders `[ka, kb]`). Boxes are empty until
@@ -75,9 +62,8 @@ impl SpanTree {
     pub fn new(n_spans: [usize; 2], window: [usize; 2]) -> Self {
         assert!(n_spans[0] > 0 && n_spans[1] > 0, "at least one span per direction");
         let na = n_spans[0] + window[0] - 1;
-        let mut tree =
-            Self { n_spans, window, na, nodes: Vec::with_capacity(2 * n_spans[0] * n_spans[1]), extraction: None };
-        tree.build(0, n_spans[0] as u32, 0, n_spans[1] as u32);
+        let mut tree = Self { n_spans, window, na, tree: BoxTree::with_capacity(2 * n_spans[0] * n_spans[1]), extraction: None };
+        tree.build([0, n_spans[0] as u32, 0, n_spans[1] as u32]);
         tree
     }
 
@@ -93,21 +79,16 @@ impl SpanTree {
         tree
     }
 
-    fn build(&mut self, s0: u32, s1: u32, t0: u32, t1: u32) -> u32 {
-        let id = self.nodes.len() as u32;
-        let empty = Node { lo: [f64::INFINITY; 3], hi: [f64::NEG_INFINITY; 3], s0, s1, t0, t1, children: [u32::MAX; 2] };
-        self.nodes.push(empty);
-        if s1 - s0 > 1 || t1 - t0 > 1 {
-            let (c0, c1) = if s1 - s0 >= t1 - t0 {
-                let m = (s0 + s1) / 2;
-                (self.build(s0, m, t0, t1), self.build(m, s1, t0, t1))
-            } else {
-                let m = (t0 + t1) / 2;
-                (self.build(s0, s1, t0, m), self.build(s0, s1, m, t1))
-            };
-            self.nodes[id as usize].children = [c0, c1];
+    fn build(&mut self, rect: Rect) -> u32 {
+        match halves(rect) {
+            None => self.tree.push_leaf(rect[0] + self.n_spans[0] as u32 * rect[2]),
+            Some((a, b)) => {
+                let id = self.tree.push_inner();
+                let children = [self.build(a), self.build(b)];
+                self.tree.set_children(id, children);
+                id
+            }
         }
-        id
     }
 
     /// Spans per direction.
@@ -116,17 +97,15 @@ impl SpanTree {
     }
 
     /// Recomputes every box from the current control points `x` (`i + na·j`).
-    /// Children are stored after their parent, so one reverse sweep suffices.
     #[allow(clippy::needless_range_loop)] // i, j, r, c: the indices of the extraction sums
     pub fn refit(&mut self, x: &[Vec3]) {
-        let [ka, kb] = self.window;
-        let na = self.na;
-        assert_eq!(x.len(), na * (self.n_spans[1] + kb - 1), "control net size");
-        for id in (0..self.nodes.len()).rev() {
-            let node = self.nodes[id];
+        let Self { n_spans, window: [ka, kb], na, tree, extraction } = self;
+        let (ns_a, ka, kb, na) = (n_spans[0], *ka, *kb, *na);
+        assert_eq!(x.len(), na * (n_spans[1] + kb - 1), "control net size");
+        tree.refit(|item| {
+            let (s, t) = (item as usize % ns_a, item as usize / ns_a);
             let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-            if let (true, Some([ea, eb])) = (node.is_leaf(), &self.extraction) {
-                let (s, t) = (node.s0 as usize, node.t0 as usize);
+            if let Some([ea, eb]) = extraction {
                 let (ea, eb) = (&ea[s], &eb[t]);
                 // rows[i][c] = Σ_r E^a_ri B_{s+r, t+c}; Bézier point (i, j) = Σ_c E^b_cj rows[i][c]
                 let mut rows = [[Vec3::zeros(); MAX_ORDER]; MAX_ORDER];
@@ -156,8 +135,7 @@ impl SpanTree {
                     lo[c] -= pad;
                     hi[c] += pad;
                 }
-            } else if node.is_leaf() {
-                let (s, t) = (node.s0 as usize, node.t0 as usize);
+            } else {
                 for j in t..t + kb {
                     for p in &x[s + na * j..s + na * j + ka] {
                         for c in 0..3 {
@@ -166,76 +144,35 @@ impl SpanTree {
                         }
                     }
                 }
-            } else {
-                for ch in node.children {
-                    let ch = &self.nodes[ch as usize];
-                    for c in 0..3 {
-                        lo[c] = lo[c].min(ch.lo[c]);
-                        hi[c] = hi[c].max(ch.hi[c]);
-                    }
-                }
             }
-            self.nodes[id].lo = lo;
-            self.nodes[id].hi = hi;
-        }
+            (lo, hi)
+        });
     }
 
     /// Diagonal of the box around the whole net (a length scale for tolerances).
     pub fn diagonal(&self) -> f64 {
-        let r = &self.nodes[0];
-        ((r.hi[0] - r.lo[0]).powi(2) + (r.hi[1] - r.lo[1]).powi(2) + (r.hi[2] - r.lo[2]).powi(2)).sqrt()
+        self.tree.diagonal()
     }
 
-    /// Box `(lo, hi)` of span `(s, t)`'s control points (linear search down the tree).
+    /// Box `(lo, hi)` of span `(s, t)`'s control points (a walk down the tree).
     pub fn span_box(&self, span: [usize; 2]) -> (Vec3, Vec3) {
         let (s, t) = (span[0] as u32, span[1] as u32);
-        let mut id = 0usize;
-        loop {
-            let n = &self.nodes[id];
-            if n.is_leaf() {
-                return (Vec3::from(n.lo), Vec3::from(n.hi));
-            }
-            id = n.children.into_iter().find(|&c| {
-                let c = &self.nodes[c as usize];
-                (c.s0..c.s1).contains(&s) && (c.t0..c.t1).contains(&t)
-            }).expect("span inside the grid") as usize;
+        let (mut id, mut rect) = (0, [0, self.n_spans[0] as u32, 0, self.n_spans[1] as u32]);
+        while let Some((a, b)) = halves(rect) {
+            let [l, r] = self.tree.children(id).expect("an inner node");
+            (id, rect) = if (a[0]..a[1]).contains(&s) && (a[2]..a[3]).contains(&t) { (l, a) } else { (r, b) };
         }
+        self.tree.node_box(id)
     }
 
-    /// Branch-and-bound walk: calls `visit(span, box_dist2)` for each span whose box
-    /// lies within `sqrt(bound2)` of `p`, nearest box first among siblings; `visit`
-    /// returns a squared distance bound it has achieved (e.g. to a surface sample)
-    /// and the walk keeps the smallest. Returns the final bound.
-    pub fn query(&self, p: &Vec3, mut bound2: f64, mut visit: impl FnMut([usize; 2], f64) -> f64) -> f64 {
-        let p = [p.x, p.y, p.z];
-        let mut stack = [(0u32, 0.0f64); STACK];
-        stack[0] = (0, self.nodes[0].dist2(&p));
-        let mut top = 1;
-        while top > 0 {
-            top -= 1;
-            let (id, d2) = stack[top];
-            if d2 > bound2 {
-                continue;
-            }
-            let n = &self.nodes[id as usize];
-            if n.is_leaf() {
-                bound2 = bound2.min(visit([n.s0 as usize, n.t0 as usize], d2));
-                continue;
-            }
-            let [c0, c1] = n.children;
-            let (d0, d1) = (self.nodes[c0 as usize].dist2(&p), self.nodes[c1 as usize].dist2(&p));
-            // push the farther child first so the nearer one is visited first
-            let (near, far) = if d0 <= d1 { ((c0, d0), (c1, d1)) } else { ((c1, d1), (c0, d0)) };
-            if far.1 <= bound2 {
-                stack[top] = far;
-                top += 1;
-            }
-            if near.1 <= bound2 {
-                stack[top] = near;
-                top += 1;
-            }
-        }
-        bound2
+    /// Branch-and-bound walk ([`BoxTree::query`]): calls `visit(span, box_dist2)` for
+    /// each span whose box lies within `sqrt(bound2)` of `p`, nearest box first among
+    /// siblings; `visit` returns a squared distance bound it has achieved (e.g. to a
+    /// surface sample) and the walk keeps the smallest. Returns the final bound.
+    #[inline]
+    pub fn query(&self, p: &Vec3, bound2: f64, mut visit: impl FnMut([usize; 2], f64) -> f64) -> f64 {
+        let ns_a = self.n_spans[0];
+        self.tree.query(p, bound2, |item, d2| visit([item as usize % ns_a, item as usize / ns_a], d2))
     }
 }
 

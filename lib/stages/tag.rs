@@ -3,10 +3,10 @@
 //!
 //! For each pair the slave set (node set, or face set through its nodes) gives the
 //! slave nodes, and the master face set is ordered into a control net
-//! ([`crate::contact::net`]). A `bspline` master takes the first that fits of:
-//! one grid (the paper's patch, open knots), a grid closed on itself (periodic
-//! knots along ξ¹), several grids (one patch each), and — for any other manifold
-//! quad surface — the Catmull–Clark limit surface (`subdivision`). `patch`,
+//! ([`crate::contact::net`]). A `bspline` master takes the first that fits of
+//! ([`smooth_net`]): one grid (the paper's patch, open knots), a grid closed on
+//! itself (periodic knots along ξ¹), several grids (one patch each), and — for any
+//! other manifold quad surface — the Catmull–Clark limit surface (`subdivision`). `patch`,
 //! `periodic`, `multipatch` and `subdivision` force one of them; `facet` takes one
 //! grid when the set is one, any quad surface otherwise. The orders are checked
 //! against every grid (order k needs at least k control points per row) and the knot
@@ -18,7 +18,7 @@ use serde::Deserialize;
 
 use super::StageRunError;
 pub use super::tag_error::TagError;
-use crate::contact::{master_net, MasterNet, NetChoice, NetError, NetShape};
+use crate::contact::{check_subdivision, master_net, smooth_net, MasterNet, NetChoice, NetShape, SmoothNet, SmoothNetError};
 use crate::format::scmesh;
 use crate::format::sccontact::{ContactModel, ContactPair, MasterKind, SlaveKind};
 use crate::mesh::Mesh;
@@ -121,8 +121,9 @@ pub fn build_pair(mesh: &Mesh, spec: &PairSpec) -> Result<ContactPair, TagError>
         slave_nodes: slave_nodes.clone(),
         net,
     };
+    let orders_err = |net: &MasterNet, source| TagError::Orders { pair: pair.clone(), master: spec.master.clone(), net: net.describe(), source };
     let check = |p: ContactPair| -> Result<ContactPair, TagError> {
-        p.check_orders().map_err(|source| TagError::Orders { pair: pair.clone(), master: spec.master.clone(), net: p.net.describe(), source })?;
+        p.check_orders().map_err(|source| orders_err(&p.net, source))?;
         Ok(p)
     };
     match spec.master_kind {
@@ -130,73 +131,27 @@ pub fn build_pair(mesh: &Mesh, spec: &PairSpec) -> Result<ContactPair, TagError>
             if let Some(o) = spec.orders.filter(|&o| o != [2, 2]) {
                 return Err(TagError::FacetOrders { pair, orders: o });
             }
-            // one grid keeps the grid's facets; anything else is a free quad set
-            let net = match master_net(mesh, &spec.master, NetChoice::Grid) {
-                Ok(net) => net,
-                Err(_) => net_of(NetChoice::Quads)?,
-            };
-            check(make(MasterKind::Facet, [2, 2], net))
+            check(make(MasterKind::Facet, [2, 2], net_of(NetChoice::GridOrQuads)?))
         }
         MasterKind::Subdivision => {
             if let Some(o) = spec.orders.filter(|&o| o != [4, 4]) {
                 return Err(TagError::SubdivisionOrders { pair, orders: o });
             }
             let net = net_of(NetChoice::Quads)?;
-            subdivision_check(mesh, &spec.master, &net).map_err(|why| TagError::Subdivision { pair: pair.clone(), master: spec.master.clone(), why })?;
+            check_subdivision(mesh, &spec.master, &net).map_err(|why| TagError::Subdivision { pair: pair.clone(), master: spec.master.clone(), why })?;
             check(make(MasterKind::Subdivision, [4, 4], net))
         }
         MasterKind::Patch => check(make(MasterKind::Bspline, bspline_orders, net_of(NetChoice::Grid)?)),
         MasterKind::Periodic => check(make(MasterKind::Bspline, bspline_orders, net_of(NetChoice::Periodic)?)),
         MasterKind::Multipatch => check(make(MasterKind::Bspline, bspline_orders, net_of(NetChoice::Patches)?)),
-        MasterKind::Bspline => {
-            // one grid, a closed grid, several grids, any quad surface: the first that fits
-            let grid = match master_net(mesh, &spec.master, NetChoice::Grid) {
-                Ok(net) => return check(make(MasterKind::Bspline, bspline_orders, net)),
-                Err(e @ (NetError::UnknownFaceSet { .. } | NetError::Empty { .. } | NetError::SpansTwoBodies { .. } | NetError::Branch { .. } | NetError::Degenerate { .. })) => return Err(master_err(e)),
-                Err(e) => e.to_string(),
-            };
-            if let Ok(net) = master_net(mesh, &spec.master, NetChoice::Periodic) {
-                return check(make(MasterKind::Bspline, bspline_orders, net));
-            }
-            let patches = match master_net(mesh, &spec.master, NetChoice::Patches) {
-                Ok(net) => {
-                    let p = make(MasterKind::Bspline, bspline_orders, net);
-                    match p.check_orders() {
-                        Ok(()) => return Ok(p),
-                        Err(e) => format!("it splits into {}, too small for orders {bspline_orders:?}: {e}", p.net.describe()),
-                    }
-                }
-                Err(e) => e.to_string(),
-            };
-            let net = net_of(NetChoice::Quads)?;
-            match subdivision_check(mesh, &spec.master, &net) {
-                Ok(()) => Ok(make(MasterKind::Subdivision, [4, 4], net)),
-                Err(subdivision) => Err(TagError::NoSmoothMaster { pair, master: spec.master.clone(), grid, patches, subdivision }),
-            }
-        }
+        MasterKind::Bspline => match smooth_net(mesh, &spec.master, bspline_orders) {
+            Ok(SmoothNet::Bspline(net)) => Ok(make(MasterKind::Bspline, bspline_orders, net)),
+            Ok(SmoothNet::Subdivision(net)) => Ok(make(MasterKind::Subdivision, [4, 4], net)),
+            Err(SmoothNetError::Net(e)) => Err(master_err(e)),
+            Err(SmoothNetError::Orders { net, source }) => Err(orders_err(&net, source)),
+            Err(SmoothNetError::NoShape { grid, patches, subdivision }) => Err(TagError::NoSmoothMaster { pair, master: spec.master.clone(), grid, patches, subdivision }),
+        },
     }
-}
-
-/// Whether the Catmull–Clark surface can be built on `net` (its boundary nodes in at
-/// most 2 faces, valences 3–14), the culprit named by gmsh tags.
-fn subdivision_check(mesh: &Mesh, master: &str, net: &MasterNet) -> Result<(), String> {
-    use crate::spline::subdivision::SubdivisionError as E;
-    let Err(e) = crate::spline::Atlas::subdivision(net.nodes.len(), net.cells()) else { return Ok(()) };
-    let node = |k: u32| net.nodes.get(k as usize).and_then(|&n| mesh.node_tags.get(n as usize)).copied().unwrap_or(k as u64);
-    let face = |f: usize| {
-        let set = mesh.face_set(master);
-        let quad = set.and_then(|s| s.quad_tags.get(f)).copied().unwrap_or(f as u64);
-        format!("quad {quad}")
-    };
-    Err(match e {
-        E::UnsupportedBoundaryNode { node: k, faces } => format!("boundary node {} (gmsh tag) lies in {faces} faces: concave corners and extraordinary boundary nodes are not supported (boundary nodes must lie in 1 or 2 faces)", node(k)),
-        E::ValenceTooLow { node: k, valence } => format!("interior node {} (gmsh tag) has valence {valence}; Catmull–Clark needs at least 3", node(k)),
-        E::ValenceTooHigh { node: k, valence, max } => format!("interior node {} (gmsh tag) has valence {valence}, above the supported {max}", node(k)),
-        E::NonManifoldVertex { node: k, .. } => format!("the faces around node {} (gmsh tag) do not form one fan", node(k)),
-        E::SupportTooLarge { face: f, nodes, max } => format!("{} depends on {nodes} nodes, more than {max}", face(f)),
-        E::StencilIncomplete { face: f } => format!("the faces around the corners of {} do not form a Catmull–Clark stencil (a mesh too small or folded there)", face(f)),
-        other => other.to_string(),
-    })
 }
 
 /// Build every pair (names unique, at least one pair).

@@ -3,8 +3,9 @@
 //!
 //! The paper orders the master nodes into one structured a × b grid. Real masters
 //! are also closed (a tube), made of several grids (a box corner, an L) or free quad
-//! meshes with extraordinary nodes (a sphere). [`master_net`] reads which one a face
-//! set is and orders it:
+//! meshes with extraordinary nodes (a sphere). [`smooth_net`] reads which one a face
+//! set is, for the B-spline orders asked for, and orders it ([`master_net`] orders it
+//! as one shape asked for):
 //!
 //! | shape | file | surface built on it |
 //! |-------|------|---------------------|
@@ -25,8 +26,8 @@ mod read;
 mod surface;
 mod types;
 
-pub use read::{control_net, master_net};
-pub use types::{ControlNet, MasterNet, NetChoice, NetError, NetShape, PatchNet};
+pub use read::{check_subdivision, control_net, master_net, smooth_net};
+pub use types::{ControlNet, MasterNet, NetChoice, NetError, NetShape, PatchNet, SmoothNet, SmoothNetError};
 
 #[cfg(test)]
 mod tests {
@@ -229,11 +230,19 @@ mod tests {
         (quad_surface(nodes, &quads), quads)
     }
 
+    /// The smooth master of a face set for orders [3, 3], which must be B-spline patches.
+    fn bspline_net(m: &Mesh, name: &str) -> MasterNet {
+        match smooth_net(m, name, [3, 3]) {
+            Ok(SmoothNet::Bspline(net)) => net,
+            other => panic!("{other:?}"),
+        }
+    }
+
     #[test]
     fn a_tube_is_a_closed_grid() {
         let (m, quads) = tube(8, 4);
         assert!(matches!(control_net(&m, "s"), Err(NetError::Hole { loops: 2, .. })));
-        let net = master_net(&m, "s", NetChoice::Auto).unwrap();
+        let net = bspline_net(&m, "s");
         assert_eq!(net.shape, NetShape::Periodic { a: 8, b: 4 });
         assert_eq!(net.describe(), "8 × 4 grid closed along ξ¹");
         cells_match(&net, &quads);
@@ -252,7 +261,7 @@ mod tests {
     fn an_l_is_three_grids() {
         let m = slab(4, 4, |i, j| i < 2 || j < 2);
         let quads: Vec<[u32; 4]> = m.face_sets[0].faces.iter().map(|&f| m.face_nodes(f)).collect();
-        let net = master_net(&m, "top", NetChoice::Auto).unwrap();
+        let net = bspline_net(&m, "top");
         let NetShape::Patches(ps) = &net.shape else { panic!("{:?}", net.shape) };
         // The re-entrant node (2,2) cuts along x = 2 and y = 2: 2×2, 2×2 and 2×2 cells.
         let mut dims: Vec<[usize; 2]> = ps.iter().map(|p| [p.a, p.b]).collect();
@@ -260,6 +269,16 @@ mod tests {
         assert_eq!(dims, vec![[3, 3], [3, 3], [3, 3]]);
         cells_match(&net, &quads);
         assert_eq!(net.nodes.len(), 21);
+        // Grids too small for the orders: not patches, and its re-entrant corner
+        // takes no Catmull–Clark surface either.
+        let Err(SmoothNetError::NoShape { grid, patches, subdivision }) = smooth_net(&m, "top", [4, 4]) else { panic!("an L of 3 × 3 grids has no order-4 master") };
+        assert!(grid.contains("non-rectangular outline"), "{grid}");
+        assert!(patches.contains("it splits into 3 grids (3 × 3, 3 × 3, 3 × 3), too small for orders [4, 4]"), "{patches}");
+        assert!(subdivision.contains("lies in 3 faces"), "{subdivision}");
+        // One grid too small is refused, not taken as something else.
+        let m = slab(2, 3, |_, _| true);
+        let e = smooth_net(&m, "top", [4, 4]).unwrap_err();
+        assert!(matches!(&e, SmoothNetError::Orders { net, .. } if net.nodes.len() == 12 && net.grid().is_some()), "{e:?}");
     }
 
     /// Three faces of the cube [0, n]³ at the corner (n, n, n): x = n, y = n, z = n.
@@ -294,7 +313,7 @@ mod tests {
     #[test]
     fn a_box_corner_is_three_grids() {
         let (m, quads) = box_corner(3);
-        let net = master_net(&m, "s", NetChoice::Auto).unwrap();
+        let net = bspline_net(&m, "s");
         assert_eq!(net.describe(), "3 grids (4 × 4, 4 × 4, 4 × 4)");
         cells_match(&net, &quads);
         assert_eq!(net.nodes.len(), 3 * 16 - 3 * 4 + 1);

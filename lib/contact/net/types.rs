@@ -1,6 +1,8 @@
 //! The master nets (one grid, a closed grid, several grids, free quads) and why a
 //! face set cannot be one.
 
+use crate::spline::{KnotVector, SplineError};
+
 /// One structured a × b grid of mesh nodes, `nodes[i + a·j]`.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ControlNet {
@@ -100,6 +102,31 @@ impl MasterNet {
         edges
     }
 
+    /// The knot vectors along ξ¹ and ξ² of a one-grid net for B-spline orders
+    /// `orders`: open uniform (eq. 5.1), or periodic along ξ¹ for a closed grid; fails
+    /// when an order does not fit the net ("a 3-node row cannot carry order 4").
+    /// `None` for other shapes.
+    pub fn knot_vectors(&self, orders: [usize; 2]) -> Result<Option<[KnotVector; 2]>, SplineError> {
+        Ok(match self.shape {
+            NetShape::Grid { a, b } => Some([KnotVector::open_uniform(a, orders[0])?, KnotVector::open_uniform(b, orders[1])?]),
+            NetShape::Periodic { a, b } => Some([KnotVector::periodic_uniform(a, orders[0])?, KnotVector::open_uniform(b, orders[1])?]),
+            NetShape::Patches(_) | NetShape::Quads(_) => None,
+        })
+    }
+
+    /// Checks that B-spline orders `orders` fit every grid of the net (each patch of
+    /// a multi-patch net).
+    pub fn check_orders(&self, orders: [usize; 2]) -> Result<(), SplineError> {
+        self.knot_vectors(orders)?;
+        if let NetShape::Patches(ps) = &self.shape {
+            for p in ps {
+                KnotVector::open_uniform(p.a, orders[0])?;
+                KnotVector::open_uniform(p.b, orders[1])?;
+            }
+        }
+        Ok(())
+    }
+
     /// "6 × 4 grid", "32 × 5 closed grid", "3 grids (4 × 4, 4 × 4, 4 × 4)", "118 quads".
     pub fn describe(&self) -> String {
         match &self.shape {
@@ -111,15 +138,40 @@ impl MasterNet {
     }
 }
 
-/// Which arrangement to build (sc-tag's per-pair choice).
+/// Which arrangement to build, when the master kind asks for one (the smooth master
+/// that fits best: [`super::smooth_net`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum NetChoice {
-    /// One grid, else closed, else several grids, else any quad surface.
-    Auto,
     Grid,
     Periodic,
     Patches,
     Quads,
+    /// One grid when the face set is one, else any quad surface (a facet master).
+    GridOrQuads,
+}
+
+/// The smooth master a face set carries ([`super::smooth_net`]).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum SmoothNet {
+    /// One grid, a closed grid or several grids: B-spline patches of the orders asked for.
+    Bspline(MasterNet),
+    /// Any other manifold quad surface: the Catmull–Clark limit surface (orders [4, 4]).
+    Subdivision(MasterNet),
+}
+
+/// Why a face set has no smooth master of the orders asked for.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SmoothNetError {
+    /// Not a manifold, consistently oriented quad surface of one body.
+    #[error(transparent)]
+    Net(#[from] NetError),
+    /// The first shape that fits, one grid or a closed grid, is too small for the orders.
+    #[error("the master is a {}: {source}", net.describe())]
+    Orders { net: MasterNet, source: SplineError },
+    /// No shape fits: why not one grid, why not several grids (or too small for the
+    /// orders), why no Catmull–Clark surface.
+    #[error("no smooth master:\n  one grid: {grid}\n  several grids: {patches}\n  subdivision: {subdivision}")]
+    NoShape { grid: String, patches: String, subdivision: String },
 }
 
 /// Why a face set cannot be a master control net. Faces are named by their gmsh

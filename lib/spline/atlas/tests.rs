@@ -215,3 +215,45 @@ fn friction_history_moves_between_charts() {
     // kink between the two facets of the wavy net)
     assert!((uv[0] + 0.2).abs() < 2e-3 && (uv[1] - 0.5).abs() < 1e-3, "{uv:?}");
 }
+
+/// What a projection costs on each master over the same 100 × 100 wavy net, one
+/// thread, the best of three rounds: the atlas (chart tree) on facets, order-3
+/// splines and the Catmull–Clark surface, and the patch and facet projectors (span
+/// tree). `cargo test --release --lib bench_projection_per_master -- --ignored --nocapture`
+#[test]
+#[ignore = "benchmark: run with --release --ignored --nocapture"]
+fn bench_projection_per_master() {
+    let n = 100;
+    let x = wavy_square_net(n);
+    let nodes: Vec<u32> = (0..(n * n) as u32).collect();
+    let pts = bench_points(n, 100_000);
+    let time = |name: &str, project: &dyn Fn(&Vec3) -> f64| {
+        let best = (0..3)
+            .map(|_| {
+                let t0 = std::time::Instant::now();
+                let g: f64 = pts.iter().map(project).sum();
+                std::hint::black_box(g);
+                t0.elapsed()
+            })
+            .min()
+            .unwrap();
+        println!("{name}: {:.3} µs per point", best.as_secs_f64() * 1e6 / pts.len() as f64);
+    };
+    let facets = AtlasProjector::new(Atlas::facets(n * n, grid_faces(n, n)), &x).unwrap();
+    time("atlas, facets", &|p| facets.project(p).0.g);
+    let splines = AtlasProjector::new(Atlas::splines(n * n, &[SheetNet { a: n, b: n, nodes: &nodes }], [3, 3], false).unwrap(), &x).unwrap();
+    time("atlas, splines [3, 3]", &|p| splines.project(p).0.g);
+    let cc = AtlasProjector::new(Atlas::subdivision(n * n, grid_faces(n, n)).unwrap(), &x).unwrap();
+    time("atlas, subdivision", &|p| cc.project(p).0.g);
+    let patch = BSplineProjector::new(BSplinePatch::new(n, n, 3, 3).unwrap(), &x).unwrap();
+    time("patch [3, 3]", &|p| patch.project(p).g);
+    let facet_net = FacetProjector::new(FacetSurface::new(n, n).unwrap(), &x).unwrap();
+    time("facet net", &|p| facet_net.project(p).g);
+    // the walks alone, bounded by the nearest box and a quarter of an edge
+    let faces = grid_faces(n, n);
+    let chart_tree = super::tree::ChartTree::new(faces.len(), &|c| &faces[c][..], &x, 0.0);
+    time("chart tree walk", &|p| chart_tree.query(p, f64::INFINITY, |_, d2| d2 + 0.25));
+    let mut span_tree = crate::spline::SpanTree::new([n - 1, n - 1], [2, 2]);
+    span_tree.refit(&x);
+    time("span tree walk", &|p| span_tree.query(p, f64::INFINITY, |_, d2| d2 + 0.25));
+}
