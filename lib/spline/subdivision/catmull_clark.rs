@@ -169,19 +169,20 @@ pub(super) struct ValenceTables {
     /// powers below; the tests read A itself).
     #[cfg_attr(not(test), allow(dead_code))]
     a: Vec<f64>,
-    /// `R_c`, c = 1, 2, 3, row-major `16 × m`, rows in grid order `(i+1) + 4(j+1)`.
-    r: [Vec<f64>; 3],
+    /// `R_c B^k` for k = 0..=levels (k = 0: `R_c` itself) and c = 1, 2, 3, each
+    /// row-major `16 × m`, rows in grid order `(i+1) + 4(j+1)`, at
+    /// `table[((k·3 + c − 1)·16 + g)·m ..]`. With `A^k = B^k + 1 w_0ᵀ` (k ≥ 1) and
+    /// `R_c 1 = 1`, a point's weights at level k are `b·(R_c B^k) + (b·1) w_0ᵀ`, whose
+    /// second term vanishes for the derivative rows (`b·1 = 0`): one 16 × m product
+    /// per evaluation. B's powers decay like λ^k, so the table keeps the subdominant
+    /// part (the derivatives) to relative precision, which `R_c A^k` would bury
+    /// under the `1 w_0ᵀ` of order 1.
+    table: Vec<f64>,
     /// Limit mask `w_0` (eq. L) over the stencil.
     pub w0: Vec<f64>,
     /// Deepest level: `λ^levels ≤ 1e-16`; closer to the vertex the point moves out
     /// to `max(s, t) = 2^{−levels}`.
     pub levels: u32,
-    /// `B^{2^j}`, j = 0, 1, …, row-major `m × m`, with `B = A − 1 w_0ᵀ` (A without its
-    /// eigenvalue 1: `A^k = B^k + 1 w_0ᵀ`, as `A 1 = 1`, `w_0ᵀ A = w_0ᵀ`, `w_0ᵀ 1 = 1`).
-    /// k levels cost one product per set bit of k (at most 7 for k ≤ 127) instead of
-    /// k; B's powers decay like λ^{2^j}, so they keep the subdominant part (the
-    /// derivatives) to relative precision, which powers of A would bury under 1.
-    powers: Vec<Vec<f64>>,
 }
 
 impl ValenceTables {
@@ -224,23 +225,26 @@ impl ValenceTables {
                 b[i * m + j] -= w0[j];
             }
         }
-        let mut powers = vec![b];
-        while (1u32 << powers.len()) <= levels {
-            let p = powers.last().expect("A itself is first");
-            let mut sq = vec![0.0; m * m];
-            for i in 0..m {
-                for l in 0..m {
-                    let pil = p[i * m + l];
-                    if pil != 0.0 {
-                        for j in 0..m {
-                            sq[i * m + j] += pil * p[l * m + j];
+        // R_c B^k, k = 0..=levels, by repeated products with B (which decay)
+        let mut table = vec![0.0; (levels as usize + 1) * 3 * 16 * m];
+        for (c, rc) in r.iter().enumerate() {
+            table[c * 16 * m..(c + 1) * 16 * m].copy_from_slice(rc);
+        }
+        for k in 1..=levels as usize {
+            let (done, rest) = table.split_at_mut(k * 3 * 16 * m);
+            let prev = &done[(k - 1) * 3 * 16 * m..];
+            for row in 0..3 * 16 {
+                let (src, dst) = (&prev[row * m..(row + 1) * m], &mut rest[row * m..(row + 1) * m]);
+                for (l, &x) in src.iter().enumerate() {
+                    if x != 0.0 {
+                        for (o, &bl) in dst.iter_mut().zip(&b[l * m..(l + 1) * m]) {
+                            *o += x * bl;
                         }
                     }
                 }
             }
-            powers.push(sq);
         }
-        Ok(Self { m, a, r, w0, levels, powers })
+        Ok(Self { m, a, w0, levels, table })
     }
 
     /// `A[i][j]`.
@@ -281,45 +285,26 @@ impl ValenceTables {
         ];
         let mut b: Rows = [[0.0; super::super::MAX_NODES]; bicubic::N_ROWS];
         bicubic::weights_into(local, n_rows, &mut b);
-        // b · R_c
-        let rc = &self.r[c - 1];
-        for (row_out, row_b) in out.iter_mut().zip(&b).take(n_rows) {
+        // b · R_c A^k = b · (R_c B^k) + (b · 1) w_0ᵀ (k ≥ 1; see `table`)
+        let at = (k as usize * 3 + c - 1) * 16 * m;
+        let pk = &self.table[at..at + 16 * m];
+        for (r, (row_out, row_b)) in out.iter_mut().zip(&b).take(n_rows).enumerate() {
             row_out[..m].fill(0.0);
             for (g, &bg) in row_b[..16].iter().enumerate() {
                 if bg != 0.0 {
-                    for (o, &x) in row_out[..m].iter_mut().zip(&rc[g * m..(g + 1) * m]) {
+                    for (o, &x) in row_out[..m].iter_mut().zip(&pk[g * m..(g + 1) * m]) {
                         *o += bg * x;
                     }
                 }
             }
+            if r == 0 && k > 0 {
+                let sum: f64 = row_b[..16].iter().sum();
+                for (o, &w) in row_out[..m].iter_mut().zip(&self.w0) {
+                    *o += sum * w;
+                }
+            }
         }
         self.deflate(n_rows, out);
-        // · A^k, as the product of A^{2^j} over the set bits j of k (powers of A
-        // commute); the derivative rows deflated after each product
-        let mut next: Rows = [[0.0; super::super::MAX_NODES]; bicubic::N_ROWS];
-        for (j, aj) in self.powers.iter().enumerate() {
-            if k & (1 << j) == 0 {
-                continue;
-            }
-            for (row_next, row) in next.iter_mut().zip(out.iter()).take(n_rows) {
-                // row · A^{2^j} = row · B^{2^j} + (row · 1) w_0ᵀ
-                let sum: f64 = row[..m].iter().sum();
-                for (o, &w) in row_next[..m].iter_mut().zip(&self.w0) {
-                    *o = sum * w;
-                }
-                for (i, &ri) in row[..m].iter().enumerate() {
-                    if ri != 0.0 {
-                        for (o, &x) in row_next[..m].iter_mut().zip(&aj[i * m..(i + 1) * m]) {
-                            *o += ri * x;
-                        }
-                    }
-                }
-            }
-            for r in 0..n_rows {
-                out[r][..m].copy_from_slice(&next[r][..m]);
-            }
-            self.deflate(n_rows, out);
-        }
         // chain rule of the level-(k+1) scaling: 2^{(k+1)(i+j)}
         for (r, &(i, j)) in ORDERS.iter().enumerate().take(n_rows).skip(1) {
             let f = scale.powi((i + j) as i32);
