@@ -68,6 +68,9 @@ pub fn solve_augmented(newton: &mut Newton, lambda: f64, u: &mut [f64], on_itera
                 node_tag: node_tags.get(node as usize).copied().unwrap_or(node as u64),
                 error,
             })?;
+            if let Some(n) = pair.mortar_skipped_cells().filter(|&n| n > 0) {
+                note(&format!("pair '{}': the mortar integration left out {n} master cells whose image over a slave face is not convex (their share of the weighted gaps is missing; a finer or less distorted master, or integration: node, avoids it)", pair.name));
+            }
             if pair.needs_augmentation() {
                 note(&format!(
                     "pair '{}': largest penetration {:.3e}{} (tolerance {:.3e}), {} active nodes: augmentation {} (λ_N ← t_N{})",

@@ -20,7 +20,9 @@
 //! ```
 //! For a facet master ∂̃g = ∂g and H is the Hessian of g (symmetric).
 
-use nalgebra::{DMatrix, DVector};
+use std::cell::RefCell;
+
+use nalgebra::{DMatrix, DVector, DVectorView};
 
 use super::{Mortar, Transfer};
 use crate::contact::element::zero_element;
@@ -30,27 +32,61 @@ use crate::contact::master::Projector;
 use crate::spline::{SurfacePoint, Vec3};
 
 /// Working rows of one quadrature point, length `m` each (reused between points).
+#[derive(Default)]
 struct Rows {
-    grad: DVector<f64>,
-    vgrad: DVector<f64>,
-    t: [DVector<f64>; 2],
-    na: [DVector<f64>; 2],
-    dxi: [DVector<f64>; 2],
-    dn: [DVector<f64>; 3],
-    dzeta: [DVector<f64>; 2],
-    tf: [DVector<f64>; 2],
-    nf: [DVector<f64>; 2],
+    grad: Vec<f64>,
+    vgrad: Vec<f64>,
+    t: [Vec<f64>; 2],
+    na: [Vec<f64>; 2],
+    dxi: [Vec<f64>; 2],
+    dn: [Vec<f64>; 3],
+    dzeta: [Vec<f64>; 2],
+    tf: [Vec<f64>; 2],
+    nf: [Vec<f64>; 2],
 }
 
-impl Rows {
-    fn new(m: usize) -> Self {
-        let z = || DVector::zeros(m);
-        Self { grad: z(), vgrad: z(), t: [z(), z()], na: [z(), z()], dxi: [z(), z()], dn: [z(), z(), z()], dzeta: [z(), z()], tf: [z(), z()], nf: [z(), z()] }
+/// The element's working storage, kept per thread between calls: it is sized to
+/// the element (`m` dofs) at each call without allocating once it has grown to the
+/// largest element.
+#[derive(Default)]
+struct Work {
+    rows: Rows,
+    /// G = Σ c ∂g and V = Σ c ∂̃g.
+    big_g: Vec<f64>,
+    big_v: Vec<f64>,
+    /// H = Σ c ∂(∂̃g), row-major m × m.
+    h: Vec<f64>,
+    /// Element dof of each trace basis node; of the friction foot point's nodes.
+    f_at: Vec<usize>,
+    idx: Vec<usize>,
+    /// The node-to-surface tangential element (residual, tangent, ∂r_T/∂t_N).
+    rt: DVector<f64>,
+    kt: DMatrix<f64>,
+    dt: DVector<f64>,
+}
+
+impl Work {
+    fn reset(&mut self, m: usize) {
+        let zero = |v: &mut Vec<f64>, n: usize| {
+            v.clear();
+            v.resize(n, 0.0);
+        };
+        let Rows { grad, vgrad, t, na, dxi, dn, dzeta, tf, nf } = &mut self.rows;
+        for v in [grad, vgrad].into_iter().chain(t.iter_mut()).chain(na.iter_mut()).chain(dxi.iter_mut()).chain(dn.iter_mut()).chain(dzeta.iter_mut()).chain(tf.iter_mut()).chain(nf.iter_mut()) {
+            zero(v, m);
+        }
+        zero(&mut self.big_g, m);
+        zero(&mut self.big_v, m);
+        zero(&mut self.h, m * m);
     }
 }
 
+thread_local! {
+    static WORK: RefCell<Work> = RefCell::new(Work::default());
+}
+
 /// Δξ̄^α = D^{αβ} (T_β − g N_β) for a surface point (rows over the element's dofs).
-fn foot_variation(sp: &SurfacePoint, g: f64, t: &[DVector<f64>; 2], na: &[DVector<f64>; 2], out: &mut [DVector<f64>; 2]) -> Result<(), ContactElementError> {
+fn foot_variation(sp: &SurfacePoint, g: f64, t: &[Vec<f64>; 2], na: &[Vec<f64>; 2], out: &mut [Vec<f64>; 2]) -> Result<(), ContactElementError> {
     let d = (sp.a_ab - sp.b_ab * g).try_inverse().ok_or(ContactElementError::FocalPoint { g_n: g })?;
     for al in 0..2 {
         for j in 0..out[al].len() {
@@ -77,6 +113,11 @@ pub struct NodeFriction<'a> {
 /// (slip: ‖t_T‖ = μ|t_s|) chained through ∂t_s/∂u = ε_N ∂ĝ_s.
 #[allow(clippy::too_many_arguments)]
 pub fn mortar_contact(mortar: &Mortar, s: usize, geometry: &Projector, x_slave: &[Vec3], law: &NormalLaw, friction: Option<NodeFriction<'_>>, r: &mut DVector<f64>, k: &mut DMatrix<f64>) -> Result<ContactState, ContactElementError> {
+    WORK.with_borrow_mut(|work| element_in(work, mortar, s, geometry, x_slave, law, friction, r, k))
+}
+
+#[allow(clippy::too_many_arguments)]
+fn element_in(work: &mut Work, mortar: &Mortar, s: usize, geometry: &Projector, x_slave: &[Vec3], law: &NormalLaw, friction: Option<NodeFriction<'_>>, r: &mut DVector<f64>, k: &mut DMatrix<f64>) -> Result<ContactState, ContactElementError> {
     let nodes = mortar.element_nodes(s);
     let m = 3 * nodes.len();
     zero_element(r, k, m);
@@ -91,9 +132,8 @@ pub fn mortar_contact(mortar: &Mortar, s: usize, geometry: &Projector, x_slave: 
     let at = |node: u32| 3 * nodes.binary_search(&node).expect("element node list holds every node it couples");
     // the master's own basis carries the forces: facets, or `transfer: surface`
     let own_basis = geometry.is_facets() || mortar.transfer == Transfer::Surface;
-    let mut rows = Rows::new(m);
-    let (mut big_g, mut big_v) = (DVector::zeros(m), DVector::zeros(m));
-    let mut h = DMatrix::zeros(m, m);
+    work.reset(m);
+    let Work { rows, big_g, big_v, h, f_at, idx, rt, kt, dt } = work;
     for &f in mortar.faces_of(s) {
         let face = mortar.face(f);
         let Some(l_s) = face.iter().position(|&c| c as usize == s) else { continue };
@@ -110,7 +150,7 @@ pub fn mortar_contact(mortar: &Mortar, s: usize, geometry: &Projector, x_slave: 
             let g = (x - sp.x_bar).dot(&n);
             let q = sp.basis.q();
             let qa = sp.basis.q_alpha();
-            let Rows { grad, vgrad, t, na, dxi, dn, dzeta, tf, nf } = &mut rows;
+            let Rows { grad, vgrad, t, na, dxi, dn, dzeta, tf, nf } = &mut *rows;
             for v in [&mut *grad, &mut *vgrad].into_iter().chain(t.iter_mut()).chain(na.iter_mut()).chain(tf.iter_mut()).chain(nf.iter_mut()) {
                 v.fill(0.0);
             }
@@ -151,15 +191,16 @@ pub fn mortar_contact(mortar: &Mortar, s: usize, geometry: &Projector, x_slave: 
             let spf = if own_basis { sp } else { mortar.trace().evaluate(p.zeta, p.cell) };
             let qf = spf.basis.q();
             let qfa = spf.basis.q_alpha();
-            let f_at: Vec<usize> = spf.basis.nodes().iter().map(|&kk| at(net[kk])).collect();
+            f_at.clear();
+            f_at.extend(spf.basis.nodes().iter().map(|&kk| at(net[kk])));
             for (a, &j) in f_at.iter().enumerate() {
                 for cc in 0..3 {
                     vgrad[j + cc] -= qf[a] * n[cc];
                 }
             }
             if own_basis {
-                dzeta[0].copy_from(&dxi[0]);
-                dzeta[1].copy_from(&dxi[1]);
+                dzeta[0].copy_from_slice(&dxi[0]);
+                dzeta[1].copy_from_slice(&dxi[1]);
             } else {
                 let nf_bar = spf.n_bar;
                 let gf = (x - spf.x_bar).dot(&nf_bar);
@@ -181,22 +222,24 @@ pub fn mortar_contact(mortar: &Mortar, s: usize, geometry: &Projector, x_slave: 
                 foot_variation(&spf, gf, tf, nf, dzeta)?;
             }
             // accumulate ĝ's gradient, the virtual gradient and H = Σ c ∂(∂̃g)
-            big_g.axpy(c, grad, 1.0);
-            big_v.axpy(c, vgrad, 1.0);
+            for j in 0..m {
+                big_g[j] += c * grad[j];
+                big_v[j] += c * vgrad[j];
+            }
             for l in 0..4 {
                 for cc in 0..3 {
                     let i = slave_at[l] + cc;
                     let w = c * p.n[l];
-                    for j in 0..m {
-                        h[(i, j)] += w * dn[cc][j];
+                    for (hij, dn_j) in h[i * m..(i + 1) * m].iter_mut().zip(&dn[cc]) {
+                        *hij += w * dn_j;
                     }
                 }
             }
             for (a, &i0) in f_at.iter().enumerate() {
                 for cc in 0..3 {
                     let i = i0 + cc;
-                    for j in 0..m {
-                        h[(i, j)] -= c * (qf[a] * dn[cc][j] + n[cc] * (qfa[a][0] * dzeta[0][j] + qfa[a][1] * dzeta[1][j]));
+                    for (j, hij) in h[i * m..(i + 1) * m].iter_mut().enumerate() {
+                        *hij -= c * (qf[a] * dn[cc][j] + n[cc] * (qfa[a][0] * dzeta[0][j] + qfa[a][1] * dzeta[1][j]));
                     }
                 }
             }
@@ -204,17 +247,21 @@ pub fn mortar_contact(mortar: &Mortar, s: usize, geometry: &Projector, x_slave: 
     }
     let a_s = law.area;
     // K = ε_N A_s V ⊗ G (+ t_s A_s H when active)
-    k.ger(law.eps_n * a_s, &big_v, &big_g, 1.0);
+    k.ger(law.eps_n * a_s, &DVectorView::from_slice(big_v, m), &DVectorView::from_slice(big_g, m), 1.0);
     if trial >= 0.0 {
         return Ok(ContactState { g_n: g_hat, t_n: 0.0, active: false });
     }
     let t_s = trial;
-    *k += &h * (t_s * a_s);
-    r.axpy(t_s * a_s, &big_v, 0.0);
+    for i in 0..m {
+        for j in 0..m {
+            k[(i, j)] += t_s * a_s * h[i * m + j];
+        }
+        r[i] = t_s * a_s * big_v[i];
+    }
     if let Some(fr) = friction {
-        let (mut rt, mut kt, mut dt) = (DVector::zeros(0), DMatrix::zeros(0, 0), DVector::zeros(0));
-        tangential_contact(&x_slave[s], fr.foot, t_s, law, fr.law, &mut rt, &mut kt, &mut dt)?;
-        let idx: Vec<usize> = std::iter::once(at(slaves[s])).chain(fr.foot.basis.nodes().iter().map(|&kk| at(net[kk]))).collect();
+        tangential_contact(&x_slave[s], fr.foot, t_s, law, fr.law, rt, kt, dt)?;
+        idx.clear();
+        idx.extend(std::iter::once(at(slaves[s])).chain(fr.foot.basis.nodes().iter().map(|&kk| at(net[kk]))));
         for (a, &ia) in idx.iter().enumerate() {
             for ca in 0..3 {
                 let i = ia + ca;

@@ -166,6 +166,12 @@ impl PairSolver {
         (self.n_active() - slip, slip)
     }
 
+    /// Mortar pairs: the master cells left out of the last integration because their
+    /// image over a slave face was not convex (`contact::mortar::segment`).
+    pub fn mortar_skipped_cells(&self) -> Option<usize> {
+        self.mortar.as_ref().map(|m| m.skipped_cells)
+    }
+
     /// Number of active slaves (after [`Self::update_states`]).
     pub fn n_active(&self) -> usize {
         self.status.iter().filter(|&&s| s == SlaveStatus::Active).count()
