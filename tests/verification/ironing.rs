@@ -195,3 +195,43 @@ const PINS_AUGMENTED_COARSE_DIE: [Pin; 3] = [
     Pin { master: "b3", v_rms: 1.10e-3, h_rms: 1.28e-3, newton: 375, cutbacks: 0 },
     Pin { master: "b4", v_rms: 3.82e-4, h_rms: 2.06e-4, newton: 294, cutbacks: 0 },
 ];
+
+/// The frictional ironing under `integration: mortar` (the constraint integrated over
+/// the die's faces, `docs/theory/mortar.md`), against the node-to-surface pins: large
+/// sliding must not get worse. Measured and pinned like the node-to-surface runs
+/// ([`Pin`]); docs/validation/ironing3d.md, "Under mortar integration", has the table.
+#[test]
+fn ironing3d_coulomb_under_mortar() {
+    let name = "ironing3d";
+    let dir = staged_pipeline(name, &["ironing3d.msh"]);
+    let path = dir.path().join(format!("pipelines/{name}.yaml"));
+    let yaml = std::fs::read_to_string(&path).unwrap();
+    let mortar = yaml.replace("{pair: contact, mu: 0.3, enforcement: penalty}", "{pair: contact, mu: 0.3, enforcement: penalty, integration: mortar}");
+    assert!(mortar.contains("integration: mortar"), "no contact line to change");
+    std::fs::write(&path, mortar).unwrap();
+    let masters = run_staged(&dir, name);
+    for ((m, h, r), node) in masters.iter().zip(&PINS_COULOMB) {
+        let v = oscillation(&h.s, &h.v, ELEMENT, STEADY.0, STEADY.1).unwrap();
+        let (its, cut) = newton_and_cutbacks(r);
+        eprintln!(
+            "mortar {m}: V mean {:.5}, V oscillation {:.3e} (node {:.3e}: {:.2}×), H ripple / V {:.3e} (node {:.3e}: {:.2}×), {its} Newton corrections (node {}: {:.2}×), {cut} cutbacks",
+            v.mean,
+            v.rms,
+            node.v_rms,
+            v.rms / node.v_rms,
+            h_ripple(h),
+            node.h_rms,
+            h_ripple(h) / node.h_rms,
+            node.newton,
+            its as f64 / node.newton as f64
+        );
+    }
+    check("mortar mu 0.3", &masters, &PINS_MORTAR);
+}
+
+/// Measured under mortar (2026-11-26); the same margins as [`PINS_COULOMB`].
+const PINS_MORTAR: [Pin; 3] = [
+    Pin { master: "facet", v_rms: 1.0, h_rms: 1.0, newton: 1, cutbacks: 0 },
+    Pin { master: "b3", v_rms: 1.0, h_rms: 1.0, newton: 1, cutbacks: 0 },
+    Pin { master: "b4", v_rms: 1.0, h_rms: 1.0, newton: 1, cutbacks: 0 },
+];
