@@ -183,6 +183,8 @@ impl SymmetricPartGmres {
     fn factor_lu(&mut self, reason: String) -> Result<(), LinearSolverError> {
         if !self.lu_analysed {
             let pattern = self.symmetric.pattern().ok_or(LinearSolverError::Order("factor", "analyse"))?;
+            // sized before it runs, from the symmetric part's Cholesky factor
+            crate::solver::memory::check_lu(self.symmetric.factor_len(), pattern.nrows(), pattern.compute_nnz(), crate::solver::memory::available()).map_err(LinearSolverError::TooLarge)?;
             self.lu.analyse(pattern.as_ref(), Symmetry::General)?;
             self.lu_analysed = true;
         }
