@@ -860,6 +860,13 @@ impl PairSolver {
         for (s, c) in self.chart_n.iter_mut().enumerate() {
             *c = charts.get(s).filter(|&&c| (c as usize) < self.projector.n_charts()).map_or(usize::MAX, |&c| c as usize);
         }
+        // and the chart the next search's hysteresis keeps, as the run left it: a
+        // node on an edge between two charts stays on the one it was on
+        if self.projector.is_atlas() {
+            for (cell, &c) in self.cells.iter_mut().zip(&self.chart_n) {
+                *cell = (c != usize::MAX).then_some([c, 0]);
+            }
+        }
         self.lambda_committed.copy_from_slice(&self.lambda_n);
         self.xi_n_committed.copy_from_slice(&self.xi_n);
         self.t_t_n_committed.copy_from_slice(&self.t_t_n);

@@ -90,7 +90,8 @@ fn a_block_slides_over_the_periodic_seam_of_a_tube() {
         let last = res.increments.last().expect("increments");
         let charts = &last.charts[0];
         assert_eq!(charts.len(), model.pairs[0].slave_nodes.len(), "{kind:?}: charts in the results");
-        let n_charts = if kind == MasterKind::Bspline { 24 * 2 } else { 48 };
+        // 24 spans around by 2 along the tube, or 24 × 2 facets
+        let n_charts = 48;
         for (s, row) in last.contact[0].iter().enumerate() {
             if row[3] == 1.0 {
                 assert!((charts[s] as usize) < n_charts, "{kind:?}: slave {s} active on chart {}", charts[s]);
@@ -121,4 +122,100 @@ fn a_block_slides_over_the_periodic_seam_of_a_tube() {
     assert!(cc.0 > 0.0 && cc.1 < 0.01, "periodic master: force {} varies by {}", cc.0, cc.1);
     assert!(cc.2 < 5e-3, "periodic master: oscillation RMS {}", cc.2);
     assert!(facet.0 > 0.0 && facet.2 > 5.0 * cc.2, "facets: force {}, oscillation RMS {} against {}", facet.0, facet.2, cc.2);
+}
+
+/// Press 0.02, slide +0.4 along y (every node in contact crosses the seam), then
+/// back by 0.2: Coulomb friction μ = 0.3, ε_T = 300 (soft enough for the nodes to
+/// stick for a few increments where the slide reverses), 10 increments per phase.
+fn frictional_setup() -> String {
+    setup()
+        .replace("[[0, 0], [1, 1], [2, 1]]", "[[0, 0], [1, 1], [3, 1]]")
+        .replace("[[0, 0], [1, 0], [2, 1]]", "[[0, 0], [1, 0], [2, 1], [3, 0.5]]")
+        .replace("displacement: {y: 0.8}", "displacement: {y: 0.4}")
+        .replace("enforcement: penalty}", "enforcement: penalty, mu: 0.3, eps_t: 300.0}")
+        .replace("increments: {count: 42, end: 2.0}", "increments: {count: 30, end: 3.0}")
+}
+
+/// Restart on an atlas master (issue 26): the frictional slide over the tube's
+/// periodic seam, cut after increment 22 (t = 2.2: the slide reversed, 12 of the 18
+/// active nodes sticking on the charts they crossed to), continued with
+/// `sc-solve --restart`. The file gives back the displacements, λ_N, ξ̄_n, t_{Tα,n}
+/// and the chart ξ̄_n lies on, which is also the chart the first search after the
+/// restart keeps at a tie (a node on the edge between two charts).
+///
+/// - With the direct LU solver the continued run repeats the uninterrupted run's
+///   operations on the same state (the solve is deterministic,
+///   `determinism.rs`): equal bit for bit, displacements, contact and friction
+///   states and every foot point's chart (measured: equal; with the first search
+///   after the restart free to take either chart at a tie, the continued run drifts
+///   by 6.5e-8 of max |u| and 1.7e-5 μN).
+/// - With the default solver (GMRES preconditioned by a factorization the
+///   uninterrupted run may have kept from an earlier iteration, inexact Newton) the
+///   two runs stop at different iterates within the residual tolerance 1e-8: within
+///   1e-8 of max |u| and of μN (measured 1.7e-10 and 4.0e-9), and the nodes in
+///   contact on the same charts (with ties between charts left to round-off:
+///   1.3e-6 μN, an active node on the other row). An open node over the valley the block presses
+///   along the crease between the tube's two rows of charts (ξ² is linear) has an
+///   orthogonal foot point on each side, as near as each other: which one the
+///   hysteresis keeps follows the Newton iterates, so open nodes may differ (no
+///   force, no t_{Tα,n}).
+///
+/// The control: with every stored chart moved one span along ξ¹, the history is read
+/// a span away and the continued run is off by more than 1e-3 of μN.
+#[test]
+fn a_restart_on_the_periodic_tube_continues_the_uninterrupted_run() {
+    use super::friction::{cut_and_continue_on, u_difference};
+    use splinecontact::format::scres::Results;
+    const CUT: usize = 22;
+    let t = tube(24, 2, 2, 2.0, 3.0, 1.0);
+    let b = block([3, 24, 2], [0.6, 2.4, 0.5], 0.0);
+    let x_top = 3.0 * (7.5f64).to_radians().cos();
+    let mesh = two_bodies("tube", &t, "block", &b, [x_top, -1.63, 0.25]);
+    let spec = pair(MasterKind::Bspline, Some([3, 2]), "block_x0", "tube_outer");
+    // 24 spans around (ξ¹) by 2 along the tube: chart s + 24 t → (s + 1) mod 24
+    let move_charts = |inc: &mut splinecontact::format::scres::Increment| {
+        for c in inc.charts[0].iter_mut().filter(|c| **c != u32::MAX) {
+            *c = (*c / 24) * 24 + (*c % 24 + 1) % 24;
+        }
+    };
+    // the largest difference of the tangential force on the block from the
+    // uninterrupted run's, after the cut, in μN
+    let dh = |a: &Results, full: &Results| {
+        let tangential = |r: &Results, k: usize| r.increments[k].info.contact[0].friction.as_ref().expect("frictional").tangential_force;
+        (CUT..full.increments.len())
+            .map(|k| {
+                let (p, q) = (tangential(a, k), tangential(full, k));
+                let n = full.increments[k].info.contact[0].force[0].abs();
+                ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt() / (0.3 * n)
+            })
+            .fold(0.0, f64::max)
+    };
+    // increments after the cut where a slave's chart differs (active ones only: `active`)
+    let charts_differ = |a: &Results, full: &Results, active: bool| {
+        a.increments[CUT..]
+            .iter()
+            .zip(&full.increments[CUT..])
+            .filter(|(x, y)| (0..y.charts[0].len()).any(|s| (!active || y.contact[0][s][3] == 1.0) && x.charts[0][s] != y.charts[0][s]))
+            .count()
+    };
+
+    let lu = frictional_setup() + "linear_solver: lu\n";
+    let [full, continued, moved] = cut_and_continue_on(mesh.clone(), &spec, &lu, CUT, move_charts);
+    let at_cut = &full.increments[CUT - 1].info.contact[0];
+    let fr = at_cut.friction.as_ref().expect("frictional");
+    assert!(at_cut.active >= 10 && fr.stick >= at_cut.active / 2, "t = 2.2 sticks: {at_cut:?}");
+    let bits = |r: &Results| -> Vec<u64> {
+        r.increments.iter().flat_map(|i| i.u.iter().flatten().chain(i.contact.iter().flatten().flatten()).chain(i.friction.iter().flatten().flatten()).map(|v| v.to_bits())).collect()
+    };
+    let (dh_moved, differ) = (dh(&moved, &full), charts_differ(&continued, &full, false));
+    eprintln!("LU: continued run off by {:.3e} max |u|, {:.3e} μN, {differ} increments with other charts; charts moved a span: {dh_moved:.3e} μN", u_difference(&continued, &full, CUT), dh(&continued, &full));
+    assert!(bits(&continued) == bits(&full), "LU: the continued run is not the uninterrupted one bit for bit");
+    assert_eq!(differ, 0, "LU: the continued run's foot points lie on the uninterrupted run's charts");
+    assert!(dh_moved > 1e-3, "the comparison does not see the charts ({dh_moved:e} μN)");
+
+    let [full, continued, _] = cut_and_continue_on(mesh, &spec, &frictional_setup(), CUT, |_| {});
+    let (du, dh_continued, differ) = (u_difference(&continued, &full, CUT), dh(&continued, &full), charts_differ(&continued, &full, true));
+    eprintln!("GMRES: continued run off by {du:.3e} max |u|, {dh_continued:.3e} μN, {differ} increments with an active node on another chart, {} with an open one", charts_differ(&continued, &full, false));
+    assert!(du <= 1e-8 && dh_continued <= 1e-8, "GMRES: continued run differs: {du:e} of max |u|, {dh_continued:e} μN");
+    assert_eq!(differ, 0, "GMRES: the active nodes of the continued run lie on the uninterrupted run's charts");
 }
