@@ -26,6 +26,7 @@ use super::definition::ContactDefinition;
 pub use super::settings::PairSettings;
 use super::settings::{Enforcement, Integration};
 use super::master::Projector;
+use super::seam::{SeamLoss, SeamWatch};
 use super::mortar::element::{mortar_contact, NodeFriction};
 use super::mortar::{Mortar, MortarError};
 use crate::spline::{Projection, SplineError, SurfacePoint, Vec3};
@@ -211,6 +212,9 @@ pub struct PairSolver {
     exchange: Vec<f64>,
     /// `integration: mortar`: the segment-to-segment integration of the gaps.
     mortar: Option<Mortar>,
+    /// Atlas masters: the active nodes on an edge between charts at the last
+    /// commit, and those the last search lost there ([`super::seam`]).
+    seams: SeamWatch,
     /// Mortar: the segmentation is held (the quadrature points keep their slave
     /// parameters and master cells; only their foot points follow), see
     /// [`Self::hold_segmentation`].
@@ -305,6 +309,7 @@ impl PairSolver {
             exchange: Vec::new(),
             mortar,
             segmentation_held: false,
+            seams: SeamWatch::default(),
         })
     }
 
@@ -386,6 +391,7 @@ impl PairSolver {
                 self.chart_n[s] = self.chart(s);
             }
         }
+        self.seams.check(&self.slaves, &self.projections, &self.cells);
         Ok(())
     }
 
@@ -835,6 +841,13 @@ impl PairSolver {
         self.xi_n_committed.copy_from_slice(&self.xi_n);
         self.t_t_n_committed.copy_from_slice(&self.t_t_n);
         self.chart_n_committed.copy_from_slice(&self.chart_n);
+        self.seams.commit(&self.projector, (0..self.slaves.len()).map(|s| (self.status[s] == SlaveStatus::Active, self.chart_n[s], self.xi_n[s])));
+    }
+
+    /// Slave nodes the last search lost at a seam between charts (atlas masters:
+    /// active at the last commit on an edge between charts, off the master now).
+    pub fn seam_losses(&self) -> &[SeamLoss] {
+        self.seams.lost()
     }
 
     /// A restart: the converged history of an increment as a results file stores it
@@ -867,6 +880,7 @@ impl PairSolver {
                 *cell = (c != usize::MAX).then_some([c, 0]);
             }
         }
+        self.seams.commit(&self.projector, state.iter().zip(&self.chart_n).map(|(row, &c)| (row[3] == SlaveStatus::Active.code(), c, [row[4], row[5]])));
         self.lambda_committed.copy_from_slice(&self.lambda_n);
         self.xi_n_committed.copy_from_slice(&self.xi_n);
         self.t_t_n_committed.copy_from_slice(&self.t_t_n);

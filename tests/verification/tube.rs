@@ -219,3 +219,56 @@ fn a_restart_on_the_periodic_tube_continues_the_uninterrupted_run() {
     assert!(du <= 1e-8 && dh_continued <= 1e-8, "GMRES: continued run differs: {du:e} of max |u|, {dh_continued:e} μN");
     assert_eq!(differ, 0, "GMRES: the active nodes of the continued run lie on the uninterrupted run's charts");
 }
+
+/// The log names a node that leaves the master from an edge between charts (issue
+/// 26: "a slave node sliding across a seam goes on without a jump in the active
+/// set, and the log names it if it cannot"), through `sc-solve`: the block pressed
+/// onto the tube (t = 1), then carried 1.2 along the tube's axis in one increment,
+/// past its end z = 1. Its middle row of slave nodes (z = 0.5) lies on the crease
+/// between the tube's two rows of charts (ξ² is linear), so those of them that were
+/// active are named, with the chart edge; the rows at z = 0.25 and 0.75, inside
+/// their charts, are not. The frictional slide of the restart test above crosses
+/// the periodic seam and the span edges with no such line.
+#[test]
+fn the_log_names_the_nodes_that_leave_the_master_from_a_seam() {
+    use crate::common::{run, stderr};
+    let t = tube(24, 2, 2, 2.0, 3.0, 1.0);
+    let b = block([3, 24, 2], [0.6, 2.4, 0.5], 0.0);
+    let x_top = 3.0 * (7.5f64).to_radians().cos();
+    let mesh = two_bodies("tube", &t, "block", &b, [x_top, -1.63, 0.25]);
+    let dir = crate::common::tempdir();
+    let specs = [pair(MasterKind::Bspline, Some([3, 2]), "block_x0", "tube_outer")];
+    let model = splinecontact::stages::tag::build_model(mesh.clone(), "t", &specs).unwrap();
+    model.write(&dir.path().join("m.sccontact")).unwrap();
+    let solve = |setup: &str, name: &str| {
+        std::fs::write(dir.path().join(format!("{name}.yaml")), setup).unwrap();
+        let o = run("sc-solve", &["m.sccontact", "--setup", &format!("{name}.yaml"), "-o", &format!("{name}.scres"), "-q"], dir.path());
+        assert!(o.status.success(), "{name}: {}", stderr(&o));
+        (stderr(&o), splinecontact::format::scres::Results::read(&dir.path().join(format!("{name}.scres"))).unwrap())
+    };
+    let jump = setup()
+        .replace("{set: block_x1, fix: [z]}", "{set: block_x1, displacement: {z: 1.2}, curve: slide}")
+        .replace("displacement: {y: 0.8}", "displacement: {y: 0.0}")
+        .replace("increments: {count: 42, end: 2.0}", "increments: {count: 2, end: 2.0}");
+    let (log, res) = solve(&jump, "jump");
+    // the slave nodes active at t = 1 with their foot point on the crease z = 0.5
+    let slaves = &model.pairs[0].slave_nodes;
+    let first = &res.increments[0];
+    let on_crease: Vec<u64> = (0..slaves.len())
+        .filter(|&s| first.contact[0][s][3] == 1.0 && (mesh.nodes[slaves[s] as usize][2] - 0.5).abs() < 1e-9)
+        .map(|s| mesh.node_tags[slaves[s] as usize])
+        .collect();
+    let named: Vec<&str> = log.lines().filter(|l| l.contains("did not cross")).collect();
+    eprintln!("{} of the active nodes on the crease: {on_crease:?}\n{}", on_crease.len(), named.join("\n"));
+    assert_eq!(res.increments[1].info.contact[0].active, 0, "the block left the tube");
+    assert!(on_crease.len() >= 3, "active nodes on the crease at t = 1: {on_crease:?}");
+    assert_eq!(named.len(), on_crease.len(), "{log}");
+    for (line, tag) in named.iter().zip(&on_crease) {
+        assert!(
+            line.starts_with("warning: increment 2/2: pair 'c': ") && line.contains(&format!("slave node {tag} was in contact")) && line.contains("(a crease)") && line.contains("on the master's boundary"),
+            "{line}"
+        );
+    }
+    let (log, _) = solve(&frictional_setup(), "slide");
+    assert!(!log.contains("did not cross"), "{log}");
+}
