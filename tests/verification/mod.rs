@@ -8,6 +8,7 @@ mod ironing;
 mod shallow_ironing;
 mod sliding;
 mod tube;
+mod multipatch_seam;
 mod ccx_compare;
 mod crash;
 mod determinism;

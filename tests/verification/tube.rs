@@ -18,14 +18,24 @@ use splinecontact::format::sccontact::MasterKind;
 use splinecontact::mesh::{Body, FaceSet, HexFace, Mesh, NodeSet};
 
 /// A tube of `na` nodes around, `nr` elements through the wall and `nz` along z;
-/// node sets `inner` (r = r0), face set `outer` (r = r1, outward).
-fn tube(na: usize, nr: usize, nz: usize, r0: f64, r1: f64, len: f64) -> Mesh {
+/// node sets `inner` (r = r0), face set `outer` (r = r1, outward). Its nodes sit at
+/// θ_i = (i − ½)·360°/na.
+pub(super) fn tube(na: usize, nr: usize, nz: usize, r0: f64, r1: f64, len: f64) -> Mesh {
+    let angles: Vec<f64> = (0..na).map(|j| (j as f64 - 0.5) * std::f64::consts::TAU / na as f64).collect();
+    ring(&angles, true, nr, nz, r0, r1, len)
+}
+
+/// A ring of hexahedra through the angles `angles` (radians, increasing), closed
+/// (the last column joins the first) or open; `nr` elements through the wall
+/// [r0, r1] and `nz` along z ∈ [0, len]; node set `inner`, face set `outer` (r = r1,
+/// outward).
+pub(super) fn ring(angles: &[f64], closed: bool, nr: usize, nz: usize, r0: f64, r1: f64, len: f64) -> Mesh {
+    let na = angles.len();
     let id = |i: usize, j: usize, k: usize| (i + (nr + 1) * (j % na + na * k)) as u32;
     let mut nodes = Vec::new();
     for k in 0..=nz {
-        for j in 0..na {
+        for &th in angles {
             for i in 0..=nr {
-                let th = (j as f64 - 0.5) * std::f64::consts::TAU / na as f64;
                 let r = r0 + (r1 - r0) * i as f64 / nr as f64;
                 nodes.push([r * th.cos(), r * th.sin(), len * k as f64 / nz as f64]);
             }
@@ -34,7 +44,7 @@ fn tube(na: usize, nr: usize, nz: usize, r0: f64, r1: f64, len: f64) -> Mesh {
     let mut hexes = Vec::new();
     let mut outer = Vec::new();
     for k in 0..nz {
-        for j in 0..na {
+        for j in 0..if closed { na } else { na - 1 } {
             for i in 0..nr {
                 // r, θ, z: e_r × e_θ = e_z, a right-handed hexahedron
                 hexes.push([id(i, j, k), id(i + 1, j, k), id(i + 1, j + 1, k), id(i, j + 1, k), id(i, j, k + 1), id(i + 1, j, k + 1), id(i + 1, j + 1, k + 1), id(i, j + 1, k + 1)]);
@@ -58,7 +68,7 @@ fn tube(na: usize, nr: usize, nz: usize, r0: f64, r1: f64, len: f64) -> Mesh {
     }
 }
 
-fn setup() -> String {
+pub(super) fn setup() -> String {
     // press 0.02 in −x over t ∈ [0, 1], then slide 0.8 in +y over t ∈ [1, 2]
     "materials:\n  - {body: tube, model: neo_hookean, E: 1.0e4, nu: 0.3}\n  - {body: block, model: neo_hookean, E: 1.0e3, nu: 0.3}\n\
      curves:\n  - {name: press, points: [[0, 0], [1, 1], [2, 1]]}\n  - {name: slide, points: [[0, 0], [1, 0], [2, 1]]}\n\
