@@ -24,7 +24,7 @@
 //! residual 5.8e-7).
 
 use super::contact::{pair, solve_model};
-use super::tube::ring;
+use super::tube::{ring, slide_figures};
 use crate::common::grid::{block, two_bodies};
 use splinecontact::contact::{MasterNet, NetShape, PatchNet};
 use splinecontact::format::sccontact::MasterKind;
@@ -68,19 +68,6 @@ fn setup() -> String {
         .replace("increments: {count: 42, end: 2.0}", "increments: {count: 50, end: 2.0}")
 }
 
-/// The normal force F_x on the block over the slide: (travel, F_x).
-fn slide(res: &splinecontact::format::scres::Results) -> (Vec<f64>, Vec<f64>) {
-    let mut travel = Vec::new();
-    let mut fx = Vec::new();
-    for inc in res.increments.iter().filter(|i| i.info.load_factor > 0.2 + 1e-9) {
-        let p = &inc.info.contact[0];
-        assert!(p.active > 0, "contact lost at t = {}", inc.info.load_factor);
-        travel.push(0.8 * (inc.info.load_factor - 0.2) / 1.8);
-        fx.push(p.force[0]);
-    }
-    (travel, fx)
-}
-
 #[test]
 fn a_seam_between_two_patches_against_one_patch() {
     let mesh = model_mesh();
@@ -96,10 +83,7 @@ fn a_seam_between_two_patches_against_one_patch() {
     let facets = splinecontact::stages::tag::build_model(mesh.clone(), "t", &[spec(MasterKind::Facet)]).unwrap();
     let mut figures = Vec::new();
     for (name, model) in [("one patch", &one), ("two patches", &two), ("facets", &facets)] {
-        let (travel, fx) = slide(&solve_model(model, &setup()));
-        let mean = fx.iter().sum::<f64>() / fx.len() as f64;
-        let spread = fx.iter().map(|f| (f - mean).abs()).fold(0.0, f64::max) / mean.abs();
-        let osc = splinecontact::post::oscillation::oscillation(&travel, &fx, 0.2, 0.1, 0.7).unwrap();
+        let (mean, spread, osc) = slide_figures(&solve_model(model, &setup()), (0.2, 2.0, 0.8), (0.1, 0.7));
         eprintln!("{name}: mean F_x {mean:.5}, max |F_x − mean|/mean {spread:.3e}, oscillation rms {:.3e} p2p {:.3e} ({} samples)", osc.rms, osc.peak_to_peak, osc.samples);
         figures.push((mean, spread, osc.rms));
     }
