@@ -53,6 +53,11 @@ impl SlaveStatus {
     }
 }
 
+/// One slave's contact configuration ([`PairSolver::configuration`]): its mesh node,
+/// whether it is pressed, the first control point carrying it (its master element)
+/// and whether it is in crease contact, per direction.
+pub type SlaveConfiguration = (u32, bool, u32, [bool; 2]);
+
 /// The closest-point projection of one slave at `xs` (the body of
 /// [`PairSolver::search`]): its projection, surface point and facet cell.
 fn project_slave(projector: &Projector, frozen: bool, edge_tolerance: f64, xs: &Vec3, proj: &mut Projection, sp: &mut SurfacePoint, cell: &mut Option<[usize; 2]>) {
@@ -461,9 +466,10 @@ impl PairSolver {
         self.settings.stabilization * self.settings.eps_n * mean_area
     }
 
-    /// Whether freezing holds anything (facet masters; frictional pairs).
+    /// Whether freezing holds anything (facet and atlas masters: their elements and
+    /// crease contact; frictional pairs).
     pub fn can_freeze(&self) -> bool {
-        matches!(self.projector, Projector::Facet(_)) || self.settings.frictional() || self.mortar.is_some()
+        matches!(self.projector, Projector::Facet(_) | Projector::Atlas(_)) || self.settings.frictional() || self.mortar.is_some()
     }
 
     /// The slave has a foot point on the patch: inside, or beyond an edge by less
@@ -690,13 +696,20 @@ impl PairSolver {
     }
 
     /// The contact configuration at the last search, one entry per slave: whether it
-    /// is pressed and which control points carry it (its first basis node) — what
-    /// changes when the active set or the master element under a node changes.
-    pub fn configuration(&self, out: &mut Vec<(u32, bool, u32)>) {
+    /// is pressed, which control points carry it (its first basis node) and, on an
+    /// atlas master, whether it is in crease contact (per direction) — what changes
+    /// when the active set, the master element under a node or its crease state
+    /// changes. (A single grid's facet net leaves the crease state out, as when its
+    /// figures were measured: with it, the frictional facet shallow ironing's ripple
+    /// halves and the concave-crease test names more nodes, a change to measure on
+    /// its own.)
+    pub fn configuration(&self, out: &mut Vec<SlaveConfiguration>) {
+        let atlas = self.projector.is_atlas();
         for s in 0..self.slaves.len() {
             let pressed = self.pressed(s);
             let first = if self.usable(s) { self.points[s].basis.nodes().first().map_or(u32::MAX, |&k| self.net[k]) } else { u32::MAX };
-            out.push((self.slaves[s], pressed, first));
+            let crease = if atlas { self.projections[s].clamped } else { [false; 2] };
+            out.push((self.slaves[s], pressed, first, crease));
         }
     }
 
