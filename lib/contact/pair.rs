@@ -699,10 +699,9 @@ impl PairSolver {
     /// is pressed, which control points carry it (its first basis node) and, on an
     /// atlas master, whether it is in crease contact (per direction) — what changes
     /// when the active set, the master element under a node or its crease state
-    /// changes. (A single grid's facet net leaves the crease state out, as when its
-    /// figures were measured: with it, the frictional facet shallow ironing's ripple
-    /// halves and the concave-crease test names more nodes, a change to measure on
-    /// its own.)
+    /// changes. (A single grid's facet net leaves the crease state out; its figures
+    /// are measured so. With it, the frictional facet shallow ironing's ripple halves
+    /// and the concave-crease test names more nodes, a change to measure on its own.)
     pub fn configuration(&self, out: &mut Vec<SlaveConfiguration>) {
         let atlas = self.projector.is_atlas();
         for s in 0..self.slaves.len() {

@@ -9,8 +9,11 @@
 //! top line x = 3 where the block touches. The block's flat bottom is tangent there;
 //! pressed 0.02 in −x and slid 0.8 in +y, every slave node in contact crosses the
 //! seam. The same mesh with a facet master is the baseline. The block's node rows sit
-//! 0.03 off the quadratic's span edge y = 0, as when the figures were measured;
+//! 0.03 off the quadratic's span edge y = 0, where the figures are measured;
 //! `nodes_on_the_quadratic_span_edge_and_on_the_crease_converge` puts a row on it.
+//!
+//! The same model also carries the restart on an atlas master (cut and continued), the
+//! log's seam warnings, and `pipelines/tube.yaml` as shipped.
 
 use crate::common::grid::{block, two_bodies};
 use super::contact::{pair, run_contact};
@@ -330,19 +333,18 @@ fn the_tube_pipeline_runs_as_shipped() {
 
 /// A row of slave nodes exactly on the quadratic's span edge y = 0 (the block 0.03
 /// further than in the test above) and a row on the crease z = 0.5 between the
-/// tube's two rows of charts (ξ² is linear). The press used to stall there at a
-/// relative residual of 2e-7 to 4e-7 and stop after 20 cutbacks: the cause was not
-/// the span edge but the crease. Two nodes of the z = 0.5 row next to the span edge
-/// touch down on the crease, 5e-7 deep, symmetric about it; from one iterate to the
-/// next they flipped between crease contact and an orthogonal foot point (iterates
-/// 1e-9 apart decide), which the contact configuration did not record, and an
-/// atlas master could not hold its search. The configuration now records the crease
-/// state, and the search holds it once it cycles (as on facets): the press goes
-/// through without a cutback (the touch-down increment in 8 Newton corrections, the
-/// search held from the 6th), and so does the slide. The control: the same block at
-/// z ∈ [0.2, 0.7], no row on the crease but the row on the span edge, needs at most
-/// 5 corrections in every increment: the span edge (the C¹ surface's curvature jump)
-/// alone does not stall Newton.
+/// tube's two rows of charts (ξ² is linear). Two nodes of the z = 0.5 row next to the
+/// span edge touch down on the crease, 5e-7 deep, symmetric about it, and flip
+/// between crease contact and an orthogonal foot point from one iterate to the next
+/// (iterates 1e-9 apart decide). The contact configuration records the crease state
+/// on an atlas master and the search is held once it cycles (as on facets): the press
+/// goes through without a cutback (the touch-down increment in 8 Newton corrections,
+/// the search held from the 6th), and so does the slide. Without the crease state in
+/// the configuration the press stalls at a relative residual of 2e-7 to 4e-7 and
+/// stops after 20 cutbacks. The control: the same block at z ∈ [0.2, 0.7], no row on
+/// the crease but the row on the span edge, needs at most 5 corrections in every
+/// increment: the span edge (the C¹ surface's curvature jump) alone does not stall
+/// Newton.
 #[test]
 fn nodes_on_the_quadratic_span_edge_and_on_the_crease_converge() {
     let t = tube(24, 2, 2, 2.0, 3.0, 1.0);
