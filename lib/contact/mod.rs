@@ -15,6 +15,7 @@
 //! | [`master`]    | the master surface behind one projection interface (B-spline or facets) |
 //! | [`mortar`]    | segment-to-segment integration of the constraint over the slave faces (`integration: mortar`) |
 //! | [`pair`]      | one pair during the solve: closest-point search (eq. 2.2), contact elements and active set, Uzawa updates and friction history |
+//! | [`seam`]      | atlas masters: active nodes that a search loses at an edge between charts, for the log |
 //! | [`adjust`]    | slave nodes moved onto the master before the first increment (stress-free) |
 
 pub mod adjust;
@@ -30,6 +31,9 @@ pub mod master;
 pub mod mortar;
 pub mod net;
 pub mod pair;
+pub mod seam;
+#[cfg(test)]
+mod seam_tests;
 pub mod settings;
 pub mod tributary;
 

@@ -272,6 +272,10 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
                                 p.node_tags.get(node as usize).copied().unwrap_or(node as u64)
                             ));
                         }
+                        for lost in c.seam_losses() {
+                            let tag = p.node_tags.get(lost.node as usize).copied().unwrap_or(lost.node as u64);
+                            log.warning(&format!("increment {}/{n_inc}: pair '{}': {}", k + 1, c.name, lost.describe(tag)));
+                        }
                     }
                     for s in &summaries {
                         if s.stabilization_force > 0.0 {

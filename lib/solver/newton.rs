@@ -22,7 +22,7 @@ use super::ranks;
 use super::stabilization::Stabilization;
 use crate::assembly::{Assembly, AssemblyError, ElementFailure, NodeGroups, Pattern, PatternError, DOFS_PER_NODE};
 use crate::contact::law::ContactElementError;
-use crate::contact::pair::{PairError, PairSolver, SearchShare};
+use crate::contact::pair::{PairError, PairSolver, SearchShare, SlaveConfiguration};
 use crate::fem::element::{hex8_gauss_stresses, hex8_residual_tangent, ElementError};
 use crate::fem::pressure::{follower_pressure_force_stiffness, FaceMatrix, FaceVector};
 use crate::format::scres::{Increment, IterationLog};
@@ -63,7 +63,7 @@ pub enum IncrementFailure {
     Contact { iteration: u32, pair: String, node_tag: u64, error: ContactElementError },
     #[error("iteration {iteration}: {message}")]
     ContactSetup { iteration: u32, message: String },
-    #[error("iteration {iteration}: the contact configuration cycles between {} states (relative residual {residual:.3e}): slave nodes {nodes} alternate between in and out of contact or between master elements", period_name(*.period))]
+    #[error("iteration {iteration}: the contact configuration cycles between {} states (relative residual {residual:.3e}): slave nodes {nodes} alternate between in and out of contact, between master elements or in and out of crease contact", period_name(*.period))]
     ContactCycling { iteration: u32, residual: f64, nodes: String, period: u32 },
 }
 
@@ -537,7 +537,7 @@ impl<'p> Newton<'p> {
         let mut max_reaction: f64 = 0.0;
         // contact configurations of the last five iterates, to detect a cycle of
         // period 2, 3 or 4
-        let mut configs: [Vec<(u32, bool, u32)>; 5] = Default::default();
+        let mut configs: [Vec<SlaveConfiguration>; 5] = Default::default();
         let mut cycling = 0u32;
         self.release_contact();
         self.frozen_at = None;

@@ -15,8 +15,14 @@ use crate::common::tempdir;
 
 /// Tag `pairs` on `mesh` and solve `setup_yaml` through the real stages.
 pub fn run_contact(mesh: &Mesh, pairs: &[PairSpec], setup_yaml: &str) -> Results {
-    let dir = tempdir();
     let model = build_model(mesh.clone(), "test", pairs).unwrap_or_else(|e| panic!("tag: {e}"));
+    solve_model(&model, setup_yaml)
+}
+
+/// Solve `setup_yaml` on a contact model through the real stages (its file written
+/// and read back).
+pub fn solve_model(model: &splinecontact::format::sccontact::ContactModel, setup_yaml: &str) -> Results {
+    let dir = tempdir();
     let c = dir.path().join("m.sccontact");
     model.write(&c).unwrap();
     let setup = SolveSetup::parse("setup", setup_yaml).unwrap_or_else(|e| panic!("{e}"));

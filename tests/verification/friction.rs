@@ -154,25 +154,31 @@ fn friction_fields_in_the_pvd() {
 /// status stopped), continue it with `sc-solve --restart`, and continue it again
 /// after `forget` erased part of the stored history: (full, continued, forgetful).
 fn cut_and_continue(yaml: &str, cut: usize, forget: impl Fn(&mut splinecontact::format::scres::Increment)) -> [splinecontact::format::scres::Results; 3] {
+    let mesh = two_bodies("lower", &block([2, 2, 1], [1.0, 1.0, 0.5], 0.0), "upper", &block([2, 2, 1], [0.5, 0.5, 0.25], 0.0), [0.25, 0.25, 0.5]);
+    cut_and_continue_on(mesh, &pair(MasterKind::Bspline, Some([3, 3]), "upper_z0", "lower_z1"), yaml, cut, forget)
+}
+
+/// [`cut_and_continue`] on any model: `mesh` tagged with `spec`.
+pub(super) fn cut_and_continue_on(mesh: splinecontact::mesh::Mesh, spec: &splinecontact::stages::tag::PairSpec, yaml: &str, cut: usize, forget: impl Fn(&mut splinecontact::format::scres::Increment)) -> [splinecontact::format::scres::Results; 3] {
     use splinecontact::format::scres::{Results, RunStatus};
     use splinecontact::format::setup::SolveSetup;
     use splinecontact::solver::log::Verbosity;
     use splinecontact::stages::solve::{solve, Restart};
     use splinecontact::stages::tag::build_model;
 
-    let mesh = two_bodies("lower", &block([2, 2, 1], [1.0, 1.0, 0.5], 0.0), "upper", &block([2, 2, 1], [0.5, 0.5, 0.25], 0.0), [0.25, 0.25, 0.5]);
     let dir = crate::common::tempdir();
-    let model = build_model(mesh, "test", &[pair(MasterKind::Bspline, Some([3, 3]), "upper_z0", "lower_z1")]).unwrap();
+    let model = build_model(mesh, "test", std::slice::from_ref(spec)).unwrap();
     let c = dir.path().join("m.sccontact");
     model.write(&c).unwrap();
     let s = SolveSetup::parse("setup", yaml).unwrap();
+    let count = s.load_factors("setup").unwrap().len();
     let run = |out: &str, restart: Option<&std::path::Path>| {
         let out = dir.path().join(out);
         if let Err(e) = solve(&c, &s, "setup", &out, None, restart.map(|file| Restart { file, increment: None }), Verbosity::Quiet) {
             panic!("{}: {e}", out.display());
         }
         let r = Results::read(&out).unwrap();
-        assert_eq!((r.status.clone(), r.increments.len()), (RunStatus::Completed, 40), "{}", out.display());
+        assert_eq!((r.status.clone(), r.increments.len()), (RunStatus::Completed, count), "{}", out.display());
         r
     };
     let full = run("full.scres", None);
@@ -190,6 +196,7 @@ fn cut_and_continue(yaml: &str, cut: usize, forget: impl Fn(&mut splinecontact::
         r.increments[..cut].iter().flat_map(|i| i.u.iter().flatten().chain(i.contact.iter().flatten().flatten()).chain(i.friction.iter().flatten().flatten()).map(|v| v.to_bits())).collect()
     };
     assert!(bits(&continued) == bits(&full), "the restart file's increments open the history");
+    assert!(continued.increments[..cut].iter().zip(&full.increments[..cut]).all(|(a, b)| a.charts == b.charts), "the restart file's charts open the history");
     forget(&mut cut_run.increments[cut - 1]);
     cut_run.write(&cut_path).unwrap();
     let forgetful = run("forgetful.scres", Some(&cut_path));
@@ -198,7 +205,7 @@ fn cut_and_continue(yaml: &str, cut: usize, forget: impl Fn(&mut splinecontact::
 
 /// Largest displacement difference over the increments after `cut`, relative to the
 /// largest displacement.
-fn u_difference(a: &splinecontact::format::scres::Results, b: &splinecontact::format::scres::Results, cut: usize) -> f64 {
+pub(super) fn u_difference(a: &splinecontact::format::scres::Results, b: &splinecontact::format::scres::Results, cut: usize) -> f64 {
     let scale = b.increments.iter().flat_map(|i| i.u.iter().flatten()).fold(0.0f64, |m, v| m.max(v.abs()));
     a.increments[cut..].iter().zip(&b.increments[cut..]).flat_map(|(x, y)| x.u.iter().flatten().zip(y.u.iter().flatten()).map(|(p, q)| (p - q).abs())).fold(0.0f64, f64::max) / scale
 }

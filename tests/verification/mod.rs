@@ -9,6 +9,7 @@ mod shallow_ironing;
 mod sliding;
 mod tube;
 mod mortar_atlas;
+mod multipatch_seam;
 mod ccx_compare;
 mod crash;
 mod determinism;

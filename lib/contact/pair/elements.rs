@@ -8,7 +8,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::{PairSolver, SlaveStatus};
+use super::{PairSolver, SlaveConfiguration, SlaveStatus};
 use crate::contact::element::{normal_contact, ContactElementError, NormalLaw};
 use crate::contact::friction::{friction_state, frictional_contact, tangential_state, FrictionLaw};
 use crate::contact::mortar::element::{mortar_contact, NodeFriction};
@@ -33,13 +33,19 @@ impl PairSolver {
     }
 
     /// The contact configuration at the last search, one entry per slave: whether it
-    /// is pressed and which control points carry it (its first basis node) — what
-    /// changes when the active set or the master element under a node changes.
-    pub fn configuration(&self, out: &mut Vec<(u32, bool, u32)>) {
+    /// is pressed, which control points carry it (its first basis node) and, on an
+    /// atlas master, whether it is in crease contact (per direction) — what changes
+    /// when the active set, the master element under a node or its crease state
+    /// changes. (A single grid's facet net leaves the crease state out; its figures
+    /// are measured so. With it, the frictional facet shallow ironing's ripple halves
+    /// and the concave-crease test names more nodes, a change to measure on its own.)
+    pub fn configuration(&self, out: &mut Vec<SlaveConfiguration>) {
+        let atlas = self.projector.is_atlas();
         for s in 0..self.slaves.len() {
             let pressed = self.pressed(s);
             let first = if self.usable(s) { self.points[s].basis.nodes().first().map_or(u32::MAX, |&k| self.net[k]) } else { u32::MAX };
-            out.push((self.slaves[s], pressed, first));
+            let crease = if atlas { self.projections[s].clamped } else { [false; 2] };
+            out.push((self.slaves[s], pressed, first, crease));
         }
     }
 

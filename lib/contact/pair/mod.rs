@@ -33,10 +33,16 @@ pub use search::SearchShare;
 use super::definition::ContactDefinition;
 use super::master::Projector;
 use super::mortar::{Mortar, MortarError};
+use super::seam::SeamWatch;
 pub use super::settings::PairSettings;
 use super::settings::Integration;
 use crate::format::sccontact::MasterKind;
 use crate::spline::{Projection, SplineError, SurfacePoint, Vec3};
+
+/// One slave's contact configuration ([`PairSolver::configuration`]): its mesh node,
+/// whether it is pressed, the first control point carrying it (its master element)
+/// and whether it is in crease contact, per direction.
+pub type SlaveConfiguration = (u32, bool, u32, [bool; 2]);
 
 /// Where a slave node stands after the last search / state update.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -134,6 +140,9 @@ pub struct PairSolver {
     exchange: Vec<f64>,
     /// `integration: mortar`: the segment-to-segment integration of the gaps.
     mortar: Option<Mortar>,
+    /// Atlas masters: the active nodes on an edge between charts at the last
+    /// commit, and those the last search lost there ([`super::seam`]).
+    seams: SeamWatch,
     /// Mortar: the segmentation is held (the quadrature points keep their slave
     /// parameters and master cells; only their foot points follow), see
     /// [`Self::hold_segmentation`].
@@ -203,6 +212,7 @@ impl PairSolver {
             exchange: Vec::new(),
             mortar,
             segmentation_held: false,
+            seams: SeamWatch::default(),
         })
     }
 

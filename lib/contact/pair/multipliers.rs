@@ -8,6 +8,7 @@
 //! traction t_{Tα,n} and the atlas chart these are expressed on.
 
 use super::{PairSolver, SlaveStatus};
+use crate::contact::seam::SeamLoss;
 use crate::contact::settings::Enforcement;
 use crate::spline::Vec3;
 
@@ -138,6 +139,13 @@ impl PairSolver {
         self.xi_n_committed.copy_from_slice(&self.xi_n);
         self.t_t_n_committed.copy_from_slice(&self.t_t_n);
         self.chart_n_committed.copy_from_slice(&self.chart_n);
+        self.seams.commit(&self.projector, (0..self.slaves.len()).map(|s| (self.status[s] == SlaveStatus::Active, self.chart_n[s], self.xi_n[s])));
+    }
+
+    /// Slave nodes the last search lost at a seam between charts (atlas masters:
+    /// active at the last commit on an edge between charts, off the master now).
+    pub fn seam_losses(&self) -> &[SeamLoss] {
+        self.seams.lost()
     }
 
     /// A restart: the converged history of an increment as a results file stores it
@@ -163,6 +171,14 @@ impl PairSolver {
         for (s, c) in self.chart_n.iter_mut().enumerate() {
             *c = charts.get(s).filter(|&&c| (c as usize) < self.projector.n_charts()).map_or(usize::MAX, |&c| c as usize);
         }
+        // and the chart the next search's hysteresis keeps, as the run left it: a
+        // node on an edge between two charts stays on the one it was on
+        if self.projector.is_atlas() {
+            for (cell, &c) in self.cells.iter_mut().zip(&self.chart_n) {
+                *cell = (c != usize::MAX).then_some([c, 0]);
+            }
+        }
+        self.seams.commit(&self.projector, state.iter().zip(&self.chart_n).map(|(row, &c)| (row[3] == SlaveStatus::Active.code(), c, [row[4], row[5]])));
         self.lambda_committed.copy_from_slice(&self.lambda_n);
         self.xi_n_committed.copy_from_slice(&self.xi_n);
         self.t_t_n_committed.copy_from_slice(&self.t_t_n);

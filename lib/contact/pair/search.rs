@@ -187,6 +187,7 @@ impl PairSolver {
                 self.chart_n[s] = self.chart(s);
             }
         }
+        self.seams.check(&self.slaves, &self.projections, &self.cells);
         Ok(())
     }
 
@@ -241,9 +242,10 @@ impl PairSolver {
         hold
     }
 
-    /// Whether freezing holds anything (facet masters; frictional pairs).
+    /// Whether freezing holds anything (facet and atlas masters: their elements and
+    /// crease contact; frictional pairs).
     pub fn can_freeze(&self) -> bool {
-        matches!(self.projector, Projector::Facet(_)) || self.settings.frictional() || self.mortar.is_some()
+        matches!(self.projector, Projector::Facet(_) | Projector::Atlas(_)) || self.settings.frictional() || self.mortar.is_some()
     }
 
     /// The slave has a foot point on the patch: inside, or beyond an edge by less

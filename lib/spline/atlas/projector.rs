@@ -5,7 +5,9 @@
 //!    the bound), then, nearest box first, every chart that can hold a point closer
 //!    than the best found so far; on each, a box-constrained Newton iteration over the
 //!    unit square (the one of [`crate::spline::projection`]), started from the chart's
-//!    nearest sample, finds the chart's closest point. The nearest wins.
+//!    nearest sample, finds the chart's closest point. The nearest wins; two as near
+//!    as each other within 1e-10 of the surface's size (a node on their shared edge)
+//!    are a tie, which the lower chart number wins, so round-off does not choose.
 //! 2. Hysteresis, as for the single facet net: the chart `prev` of the last search is
 //!    kept while its foot point is no farther than the best by 1e-6 of the surface's
 //!    size (1e-4 where both are orthogonal projections), so a node on a shared edge
@@ -39,6 +41,9 @@ pub struct AtlasProjector {
 const UNIT: ([f64; 2], [f64; 2]) = ([0.0; 2], [1.0; 2]);
 /// Samples per direction and chart.
 const S: usize = 3;
+/// Foot points on two charts whose distances differ by no more than this fraction
+/// of the surface's size are a tie (broken by the chart number).
+const TIE: f64 = 1e-10;
 
 fn sample_uv(k: usize) -> [f64; 2] {
     [((k % S) as f64 + 0.5) / S as f64, ((k / S) as f64 + 0.5) / S as f64]
@@ -144,19 +149,33 @@ impl AtlasProjector {
             let res = self.newton_from(p, seed.1, seed.2, UNIT);
             best = Some(((p - res.jet.x).norm_squared(), res, seed.1));
         }
+        // Two charts as near as each other within TIE · size (a node on the edge
+        // between them): the lower chart number wins, whatever round-off says, so
+        // the choice does not depend on the order of the search or on the last bits
+        // of the positions (a restart meets the uninterrupted run's choice).
+        let tie = TIE * self.scale;
+        let widen = |d2: f64| (d2.sqrt() + tie).powi(2) * (1.0 + 1e-12);
         // a chart can hold a closer point only if its box is within the best distance
-        // (a hair wider: round-off in the samples' distances)
-        let bound = best.as_ref().map_or(f64::INFINITY, |b| b.0.min(seed.0)) * (1.0 + 1e-12);
+        // (a hair wider: round-off in the samples' distances, and the tie)
+        let bound = widen(best.as_ref().map_or(f64::INFINITY, |b| b.0.min(seed.0)));
         self.tree.query(p, bound, |chart, _| {
             if chart != seed.1 {
                 let (_, uv) = self.nearest_sample(p, chart);
                 let res = self.newton_from(p, chart, uv, UNIT);
                 let d2 = (p - res.jet.x).norm_squared();
-                if best.as_ref().is_none_or(|b| d2 < b.0) {
+                let wins = |b: &(f64, NewtonResult, usize)| {
+                    let (d, db) = (d2.sqrt(), b.0.sqrt());
+                    if (d - db).abs() <= tie {
+                        chart < b.2
+                    } else {
+                        d < db
+                    }
+                };
+                if best.as_ref().is_none_or(wins) {
                     best = Some((d2, res, chart));
                 }
             }
-            best.as_ref().map_or(f64::INFINITY, |b| b.0 * (1.0 + 1e-12))
+            best.as_ref().map_or(f64::INFINITY, |b| widen(b.0))
         });
         let Some((d2, mut res, mut chart)) = best else {
             let nan = Projection { xi: [f64::NAN; 2], x_bar: Vec3::from_element(f64::NAN), g: f64::NAN, inside: false, iterations: 0, converged: false, clamped: [false; 2] };
