@@ -112,6 +112,10 @@ pub struct Mortar {
     pub skipped_cells: usize,
     /// Through which basis the master receives the forces.
     pub transfer: Transfer,
+    /// A face whose corners' own foot points all lie farther than this in front of
+    /// the master is not integrated (no slave node near it can be pressed; the
+    /// pair sets twice its capture distance, default: every face is integrated).
+    pub far: f64,
     /// Mesh node of every control point, and of every slave.
     net: Vec<u32>,
     slaves: Vec<u32>,
@@ -168,6 +172,7 @@ impl Mortar {
             nodes: vec![Vec::new(); n],
             skipped_cells: 0,
             transfer,
+            far: f64::INFINITY,
             net: net.nodes.clone(),
             slaves: slaves.to_vec(),
         }))
@@ -246,7 +251,7 @@ impl Mortar {
         self.node_cell.par_iter_mut().zip(x_slave.par_iter()).with_min_len(64).for_each(|(c, x)| {
             *c = trace.locate(x, *c);
         });
-        let node_cell = &self.node_cell;
+        let (node_cell, far) = (&self.node_cell, self.far);
         let skipped: usize = self
             .points
             .par_iter_mut()
@@ -256,6 +261,9 @@ impl Mortar {
             .with_min_len(16)
             .map(|(f, ((pts, face), x0))| {
                 pts.clear();
+                if face.iter().all(|&s| feet.projections[s as usize].converged && feet.projections[s as usize].g > far) {
+                    return 0;
+                }
                 let xf = face.map(|s| x_slave[s as usize]);
                 let Some(mut plane) = FacePlane::new(&xf) else { return 0 };
                 if signed_area2(&plane.corners) < 0.0 {
