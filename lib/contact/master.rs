@@ -63,6 +63,18 @@ impl Projector {
             }
         }
     }
+    /// The closest point near a known one: on an atlas, first on the chart of
+    /// `near` (its element and parameter) alone, accepted when strictly inside it;
+    /// otherwise, and on other masters, [`Self::project`] kept on `near`'s element.
+    pub fn project_near(&self, p: &Vec3, near: Option<([usize; 2], [f64; 2])>) -> (Projection, Option<[usize; 2]>) {
+        if let (Self::Atlas(pr), Some((element, uv))) = (self, near) {
+            if let Some(proj) = pr.project_on_chart_interior(p, element[0], uv) {
+                return (proj, Some(element));
+            }
+        }
+        self.project(p, near.map(|n| n.0))
+    }
+
     /// With the master element held (a frozen search): a facet slave projects onto
     /// its last cell's continued bilinear map, a slave in crease contact onto the same
     /// crease (`last`: its previous projection); a B-spline slave as usual (the patch

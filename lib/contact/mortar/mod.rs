@@ -505,7 +505,7 @@ fn project_point(geometry: &Projector, trace: &Trace, x: &Vec3, cell: usize, sta
     }
     let (p, element) = match geometry {
         Projector::BSpline(pr) => (start.xi.map_or_else(|| pr.project(x), |xi0| pr.project_warm(x, xi0)), None),
-        _ => geometry.project(x, start.element),
+        _ => geometry.project_near(x, start.element.zip(start.xi)),
     };
     if !(p.converged && p.inside) {
         return None;

@@ -128,6 +128,21 @@ impl AtlasProjector {
         self.project_keeping(p, None)
     }
 
+    /// The closest point on `chart` alone, from `uv0`, when Newton finds it strictly
+    /// inside the chart with p − x̄ orthogonal to the surface; otherwise `None` (the
+    /// caller then searches all charts). A local foot point next to a known one:
+    /// mortar quadrature points start from their face corner's or their own last
+    /// chart, where most of them stay.
+    pub fn project_on_chart_interior(&self, p: &Vec3, chart: usize, uv0: [f64; 2]) -> Option<Projection> {
+        if chart >= self.atlas.n_charts() {
+            return None;
+        }
+        let start = uv0.map(|u| if u.is_finite() { u.clamp(0.0, 1.0) } else { 0.5 });
+        let res = self.newton_from(p, chart, start, UNIT);
+        let interior = res.xi.iter().all(|&u| u > 0.0 && u < 1.0);
+        (res.converged && interior && self.orthogonal(p, &res)).then(|| self.finish(p, &res, chart, UNIT))
+    }
+
     /// Closest point with hysteresis on the chart `prev` (module docs, steps 1–3).
     pub fn project_keeping(&self, p: &Vec3, prev: Option<usize>) -> (Projection, usize) {
         let prev = prev.filter(|&c| c < self.atlas.n_charts());
