@@ -85,6 +85,9 @@ struct Piece {
     origin: [f64; 2],
     /// `jac[a][α] = ∂s_a/∂u_α` (local `(s, t)` from face `(u, v)`).
     jac: [[f64; 2]; 2],
+    /// The chain rule (s, t) → (u, v) of the derivative rows: row r of the face's
+    /// derivatives is `Σ chain[r][r'] · row r'` over the rows r' of the same order.
+    chain: [[f64; N_ROWS]; N_ROWS],
     /// `None`: regular bicubic piece (stencil rows in grid order); `Some(N)`: `2N+8` stencil.
     valence: Option<usize>,
     /// First stencil row in [`CatmullClark::row_ptr`].
@@ -223,7 +226,7 @@ impl CatmullClark {
             }
             self.row_ptr.push(self.entries.len() as u32);
         }
-        self.pieces.push(Piece { origin, jac, valence: (n != 4).then_some(n), first_row });
+        self.pieces.push(Piece { origin, jac, chain: chain_rule(&jac), valence: (n != 4).then_some(n), first_row });
         Ok(())
     }
 
@@ -295,26 +298,19 @@ impl CatmullClark {
                 }
             }
         }
-        // chain rule (s, t) → (u, v): ∂_α = Σ_a jac[a][α] ∂_a, per order
-        for col in 0..len {
-            w[0][col] = g[0][col];
-            for (r, &(i, j)) in ORDERS.iter().enumerate().take(n_rows).skip(1) {
-                let order = i + j;
-                let alpha = |q: usize| usize::from(q >= i); // i derivatives along u, then j along v
-                let mut sum = 0.0;
-                for bits in 0..1usize << order {
-                    let mut prod = 1.0;
-                    let mut n_t = 0;
-                    for q in 0..order {
-                        let a = (bits >> q) & 1;
-                        prod *= p.jac[a][alpha(q)];
-                        n_t += a;
-                    }
-                    if prod != 0.0 {
-                        sum += prod * g[row_of(order - n_t, n_t)][col];
+        // chain rule (s, t) → (u, v), per order (`Piece::chain`)
+        w[0][..len].copy_from_slice(&g[0][..len]);
+        for (r, &(i, j)) in ORDERS.iter().enumerate().take(n_rows).skip(1) {
+            let first = row_of(i + j, 0);
+            let row = &mut w[r][..len];
+            row.fill(0.0);
+            for r2 in first..=first + i + j {
+                let c = p.chain[r][r2];
+                if c != 0.0 {
+                    for (o, &x) in row.iter_mut().zip(&g[r2][..len]) {
+                        *o += c * x;
                     }
                 }
-                w[r][col] = sum;
             }
         }
         self.face_support(face)
@@ -393,4 +389,28 @@ impl CatmullClark {
         }
         Jet { x: d[0], a: [d[1], d[2]], aa: [[d[3], d[4]], [d[4], d[5]]] }
     }
+}
+
+
+/// The chain rule of the derivative rows for a piece whose local `(s, t)` follow
+/// from the face's `(u, v)` by `jac[a][α] = ∂s_a/∂u_α`: `∂_α = Σ_a jac[a][α] ∂_a`,
+/// applied i times along u and j times along v for row (i, j).
+fn chain_rule(jac: &[[f64; 2]; 2]) -> [[f64; N_ROWS]; N_ROWS] {
+    let mut t = [[0.0; N_ROWS]; N_ROWS];
+    t[0][0] = 1.0;
+    for (r, &(i, j)) in ORDERS.iter().enumerate().skip(1) {
+        let order = i + j;
+        let alpha = |q: usize| usize::from(q >= i); // i derivatives along u, then j along v
+        for bits in 0..1usize << order {
+            let mut prod = 1.0;
+            let mut n_t = 0;
+            for q in 0..order {
+                let a = (bits >> q) & 1;
+                prod *= jac[a][alpha(q)];
+                n_t += a;
+            }
+            t[r][row_of(order - n_t, n_t)] += prod;
+        }
+    }
+    t
 }
