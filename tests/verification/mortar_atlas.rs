@@ -6,10 +6,11 @@
 //! one-grid cases are in `contact.rs`).
 
 use splinecontact::format::sccontact::MasterKind;
-use splinecontact::mesh::{Body, FaceSet, HexFace, Mesh, NodeSet};
+use splinecontact::mesh::{FaceSet, HexFace, Mesh, NodeSet};
 
 use super::contact::{pair, patch_on, patch_setup, Patch};
-use crate::common::grid::{block, two_bodies};
+use super::tube::ring;
+use crate::common::grid::{add_node_set, block, two_bodies};
 
 /// `mesh` with only the hexahedra `keep` accepts, and each `(from, into, x)` node
 /// `from` merged into `into`, which moves to `x`; unused nodes are dropped and the
@@ -95,52 +96,26 @@ fn collapsed_block(n: usize) -> Mesh {
     carve(&b, |h| h % (n * n) != 1 + n, &merge)
 }
 
-/// A thick-walled tube about z: `na` nodes around (θ = 2πj/na, so nodes lie on the
-/// planes x = 0 and y = 0 when 4 divides na), `nr` elements through the wall, `nz`
-/// along z over [0, len]. Body "tube"; node sets `all`, `x0` (x = 0), `y0` (y = 0),
-/// `top`; face sets `top` and `bottom` (outward), flat annuli.
+/// A thick-walled tube about z: the ring of `tube.rs` with `na` nodes around at
+/// θ = 2πj/na (so nodes lie on the planes x = 0 and y = 0 when 4 divides na), `nr`
+/// elements through the wall, `nz` along z over [0, len]. Body "tube"; node sets
+/// `all`, `x0` (x = 0), `y0` (y = 0), `top`; face sets `top` and `bottom` (outward),
+/// flat annuli.
 fn annulus_tube(na: usize, nr: usize, nz: usize, r: [f64; 2], len: f64) -> Mesh {
-    let id = |i: usize, j: usize, k: usize| (i + (nr + 1) * (j % na + na * k)) as u32;
-    let mut nodes = Vec::new();
-    for k in 0..=nz {
-        for j in 0..na {
-            for i in 0..=nr {
-                let th = j as f64 * std::f64::consts::TAU / na as f64;
-                let rad = r[0] + (r[1] - r[0]) * i as f64 / nr as f64;
-                nodes.push([rad * th.cos(), rad * th.sin(), len * k as f64 / nz as f64]);
-            }
-        }
+    let angles: Vec<f64> = (0..na).map(|j| j as f64 * std::f64::consts::TAU / na as f64).collect();
+    let mut mesh = ring(&angles, true, nr, nz, r[0], r[1], len);
+    add_node_set(&mut mesh, "all", |_| true);
+    add_node_set(&mut mesh, "x0", |p| p[0].abs() < 1e-12);
+    add_node_set(&mut mesh, "y0", |p| p[1].abs() < 1e-12);
+    add_node_set(&mut mesh, "top", |p| (p[2] - len).abs() < 1e-12);
+    // the ring's hexahedra run i (wall) fastest, then j (around), then k (along z);
+    // local face 0 is z−, 1 is z+ (as in common::grid::block)
+    let layer = nr * na;
+    for (name, first, local) in [("top", (nz - 1) * layer, 1u8), ("bottom", 0, 0u8)] {
+        let faces: Vec<HexFace> = (first..first + layer).map(|e| HexFace { element: e as u32, local }).collect();
+        mesh.face_sets.push(FaceSet { name: name.into(), physical_tag: 0, quad_tags: vec![0; faces.len()], faces });
     }
-    let (mut hexes, mut top, mut bottom) = (Vec::new(), Vec::new(), Vec::new());
-    for k in 0..nz {
-        for j in 0..na {
-            for i in 0..nr {
-                // r, θ, z: e_r × e_θ = e_z, a right-handed hexahedron; local face 0 is
-                // z−, 1 is z+ (as in common::grid::block)
-                hexes.push([id(i, j, k), id(i + 1, j, k), id(i + 1, j + 1, k), id(i, j + 1, k), id(i, j, k + 1), id(i + 1, j, k + 1), id(i + 1, j + 1, k + 1), id(i, j + 1, k + 1)]);
-                let e = hexes.len() as u32 - 1;
-                if k == 0 {
-                    bottom.push(HexFace { element: e, local: 0 });
-                }
-                if k + 1 == nz {
-                    top.push(HexFace { element: e, local: 1 });
-                }
-            }
-        }
-    }
-    let on = |f: &dyn Fn(&[f64; 3]) -> bool| -> Vec<u32> { (0..nodes.len()).filter(|&v| f(&nodes[v])).map(|v| v as u32).collect() };
-    let node_sets = vec![
-        NodeSet { name: "all".into(), physical_tag: 0, dim: 3, nodes: on(&|_| true) },
-        NodeSet { name: "x0".into(), physical_tag: 0, dim: 2, nodes: on(&|p| p[0].abs() < 1e-12) },
-        NodeSet { name: "y0".into(), physical_tag: 0, dim: 2, nodes: on(&|p| p[1].abs() < 1e-12) },
-        NodeSet { name: "top".into(), physical_tag: 0, dim: 2, nodes: on(&|p| (p[2] - len).abs() < 1e-12) },
-    ];
-    let face_sets = vec![
-        FaceSet { name: "top".into(), physical_tag: 0, quad_tags: vec![0; top.len()], faces: top },
-        FaceSet { name: "bottom".into(), physical_tag: 0, quad_tags: vec![0; bottom.len()], faces: bottom },
-    ];
-    let m = hexes.len();
-    Mesh { node_tags: (1..=nodes.len() as u64).collect(), nodes, hexes, hex_body: vec![0; m], bodies: vec![Body { name: "tube".into(), physical_tag: 1 }], node_sets, face_sets, element_tags: (1..=m as u64).collect() }
+    mesh
 }
 
 /// The patch test's exact state and tolerance, as in `contact.rs`: two linear
