@@ -259,74 +259,76 @@ impl Mortar {
             .zip(self.faces_ref.par_iter())
             .enumerate()
             .with_min_len(16)
-            .map(|(f, ((pts, face), x0))| {
-                pts.clear();
-                if face.iter().all(|&s| feet.projections[s as usize].converged && feet.projections[s as usize].g > far) {
-                    return 0;
-                }
-                let xf = face.map(|s| x_slave[s as usize]);
-                let Some(mut plane) = FacePlane::new(&xf) else { return 0 };
-                if signed_area2(&plane.corners) < 0.0 {
-                    plane.corners.reverse();
-                }
-                let mut queue: Vec<(usize, bool)> = Vec::with_capacity(16);
-                for &s in face {
-                    if let Some(c) = node_cell[s as usize] {
-                        if !queue.iter().any(|q| q.0 == c) {
-                            queue.push((c, true));
+            // per thread: the walk's queue and the clipping's polygons
+            .map_init(
+                || (Vec::<(usize, bool)>::with_capacity(16), Vec::with_capacity(8), Vec::with_capacity(8)),
+                |(queue, seg, scratch), (f, ((pts, face), x0))| {
+                    pts.clear();
+                    if face.iter().all(|&s| feet.projections[s as usize].converged && feet.projections[s as usize].g > far) {
+                        return 0;
+                    }
+                    let xf = face.map(|s| x_slave[s as usize]);
+                    // its projected corners run counter-clockwise (the frame's e₂ = n × e₁)
+                    let Some(plane) = FacePlane::new(&xf) else { return 0 };
+                    queue.clear();
+                    for &s in face {
+                        if let Some(c) = node_cell[s as usize] {
+                            if !queue.iter().any(|q| q.0 == c) {
+                                queue.push((c, true));
+                            }
                         }
                     }
-                }
-                if queue.is_empty() {
-                    return 0;
-                }
-                let corner = face.iter().map(|&s| s as usize).find(|&s| feet.projections[s].converged);
-                let start = Start { xi: corner.map(|s| feet.projections[s].xi), element: corner.and_then(|s| feet.elements[s]) };
-                let (mut seg, mut scratch) = (Vec::with_capacity(8), Vec::with_capacity(8));
-                let mut skipped = 0;
-                let mut next = 0;
-                while next < queue.len() {
-                    let (cell, seed) = queue[next];
-                    next += 1;
-                    let cuts = match segment(trace, x_net, &plane, cell, &mut seg, &mut scratch) {
-                        Segment::Cut => {
-                            // back to the face: the segment's vertices to η (module `segment`, step 4)
-                            let mut back = true;
-                            for v in seg.iter_mut() {
-                                match plane.eta(v) {
-                                    Some(eta) => *v = P2::new(eta[0], eta[1]),
-                                    None => back = false,
+                    if queue.is_empty() {
+                        return 0;
+                    }
+                    let corner = face.iter().map(|&s| s as usize).find(|&s| feet.projections[s].converged);
+                    let start = Start { xi: corner.map(|s| feet.projections[s].xi), element: corner.and_then(|s| feet.elements[s]) };
+                    let mut skipped = 0;
+                    let mut next = 0;
+                    while next < queue.len() {
+                        let (cell, seed) = queue[next];
+                        next += 1;
+                        let cuts = match segment(trace, x_net, &plane, cell, seg, scratch) {
+                            Segment::Cut => {
+                                // back to the face: the segment's vertices to η (module `segment`, step 4)
+                                let mut back = true;
+                                for v in seg.iter_mut() {
+                                    match plane.eta(v) {
+                                        Some(eta) => *v = P2::new(eta[0], eta[1]),
+                                        None => back = false,
+                                    }
+                                }
+                                if back {
+                                    polygon_quadrature(seg, |eta, w| {
+                                        let (xq, _) = face_point(&xf, eta);
+                                        let Some(Foot { xi, element, zeta, g }) = project_point(geometry, trace, &xq, cell, start) else {
+                                            return;
+                                        };
+                                        let (n, _) = quad4(eta);
+                                        pts.push(MortarPoint { face: f as u32, n, w: w * face_jacobian(x0, eta), cell, element, xi, zeta, g });
+                                    });
+                                } else {
+                                    skipped += 1;
+                                }
+                                true
+                            }
+                            Segment::NotConvex => {
+                                skipped += 1;
+                                false
+                            }
+                            Segment::Empty => false,
+                        };
+                        if cuts || seed {
+                            for d in trace.neighbours(cell) {
+                                if !queue.iter().any(|q| q.0 == d) {
+                                    queue.push((d, false));
                                 }
                             }
-                            if !back {
-                                skipped += 1;
-                            }
-                            polygon_quadrature(if back { &seg } else { &[] }, |eta, w| {
-                                let (xq, _) = face_point(&xf, eta);
-                                let Some(Foot { xi, element, zeta, g }) = project_point(geometry, trace, &xq, cell, start) else {
-                                    return;
-                                };
-                                let (n, _) = quad4(eta);
-                                pts.push(MortarPoint { face: f as u32, n, w: w * face_jacobian(x0, eta), cell, element, xi, zeta, g });
-                            });
-                            true
-                        }
-                        Segment::NotConvex => {
-                            skipped += 1;
-                            false
-                        }
-                        Segment::Empty => false,
-                    };
-                    if cuts || seed {
-                        for d in trace.neighbours(cell) {
-                            if !queue.iter().any(|q| q.0 == d) {
-                                queue.push((d, false));
-                            }
                         }
                     }
-                }
-                skipped
-            })
+                    skipped
+                },
+            )
             .sum();
         self.skipped_cells = skipped;
         self.gather(geometry, feet, areas);

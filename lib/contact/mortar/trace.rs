@@ -114,7 +114,7 @@ impl Trace {
     pub fn locate(&self, x: &Vec3, prev: Option<usize>) -> Option<usize> {
         match &self.facets {
             Facets::Grid { projector, cells_a } => {
-                let (p, cell) = projector.project_keeping(x, prev.map(|c| [c % cells_a, c / cells_a]));
+                let (p, cell) = projector.project_keeping(x, prev.map(|c| self.element(c)));
                 p.converged.then_some(cell[0] + cells_a * cell[1])
             }
             Facets::Quads(projector) => {
