@@ -5,14 +5,23 @@
 
 use splinecontact::format::scres::{Results, RunStatus};
 
-use crate::common::{repo, run, stderr, staged_meshes, staged_pipeline};
+use crate::common::{repo, run, stderr, staged_meshes};
 
 /// Run `pipelines/<name>.yaml` in a copy of meshes/ and pipelines/.
 fn run_pipeline(name: &str) -> Results {
-    let dir = staged_pipeline(name, &[&format!("{name}.msh")]);
+    run_edited(name, str::to_string).0
+}
+
+/// Run `pipelines/<name>.yaml`, its text changed by `edit`, in a copy of meshes/ and
+/// pipelines/: the results and the log.
+fn run_edited(name: &str, edit: impl Fn(&str) -> String) -> (Results, String) {
+    let dir = staged_meshes(&[&format!("{name}.msh")]);
+    let yaml = std::fs::read_to_string(repo().join(format!("pipelines/{name}.yaml"))).unwrap();
+    std::fs::write(dir.path().join(format!("pipelines/{name}.yaml")), edit(&yaml)).unwrap();
     let o = run("sc-pipeline", &[&format!("pipelines/{name}.yaml")], dir.path());
-    assert!(o.status.success(), "{name}: {}", stderr(&o));
-    Results::read(&dir.path().join(format!("pipelines/out/{name}.scres"))).unwrap()
+    let err = stderr(&o);
+    assert!(o.status.success(), "{name}: {err}");
+    (Results::read(&dir.path().join(format!("pipelines/out/{name}.scres"))).unwrap(), err)
 }
 
 /// Largest displacement magnitude of the last increment and the gmsh tag of its node.
@@ -71,30 +80,27 @@ fn paper_examples_are_pinned() {
 fn default_penalty_reproduces_the_paper_examples() {
     let pins = [("crossed_beams", 1.11427661), ("parallel_beams", 0.33898814), ("supported_beam", 0.79809336)];
     for (name, u_pin) in pins {
-        let dir = staged_meshes(&[&format!("{name}.msh")]);
-        let yaml = std::fs::read_to_string(repo().join(format!("pipelines/{name}.yaml"))).unwrap();
         // drop the penalties from the contact entry
-        let stripped: String = yaml
-            .lines()
-            .map(|l| {
-                let mut l = l.to_string();
-                for key in ["eps_n", "eps_t"] {
-                    if let Some(a) = l.find(&format!("{key}: ")) {
-                        let end = l[a..].find([',', '}']).map_or(l.len(), |e| a + e);
-                        let end = if l[end..].starts_with(',') { end + 1 } else { end };
-                        l.replace_range(a..end, "");
+        let strip = |yaml: &str| -> String {
+            let stripped: String = yaml
+                .lines()
+                .map(|l| {
+                    let mut l = l.to_string();
+                    for key in ["eps_n", "eps_t"] {
+                        if let Some(a) = l.find(&format!("{key}: ")) {
+                            let end = l[a..].find([',', '}']).map_or(l.len(), |e| a + e);
+                            let end = if l[end..].starts_with(',') { end + 1 } else { end };
+                            l.replace_range(a..end, "");
+                        }
                     }
-                }
-                l + "\n"
-            })
-            .collect();
-        assert!(!stripped.contains("eps_n:") && !stripped.contains("eps_t:"), "{name}: penalties left in\n{stripped}");
-        std::fs::write(dir.path().join(format!("pipelines/{name}.yaml")), stripped).unwrap();
-        let o = run("sc-pipeline", &[&format!("pipelines/{name}.yaml")], dir.path());
-        let err = stderr(&o);
-        assert!(o.status.success(), "{name}: {err}");
+                    l + "\n"
+                })
+                .collect();
+            assert!(!stripped.contains("eps_n:") && !stripped.contains("eps_t:"), "{name}: penalties left in\n{stripped}");
+            stripped
+        };
+        let (r, err) = run_edited(name, strip);
         assert!(err.contains("(default 25 G/h"), "{name}: the log names the default penalty\n{err}");
-        let r = Results::read(&dir.path().join(format!("pipelines/out/{name}.scres"))).unwrap();
         let (u, _) = max_displacement(&r);
         eprintln!("{name}: default penalty max |u| = {u:.8} (pinned {u_pin}, rel. {:.1e})", (u - u_pin).abs() / u_pin);
         assert!((u - u_pin).abs() < 3e-3 * u_pin, "{name}: {u} vs {u_pin}");
@@ -109,7 +115,8 @@ fn default_penalty_reproduces_the_paper_examples() {
 /// face that overhangs it (the crossed beams, the supported beam: 10 mm faces), the
 /// weighted gaps of that face's two node rows put the reaction at its weighted centre
 /// inside the edge, not on the edge row as node-to-surface does: the lever arm grows
-/// and the tip deflects 11 % and 3.4 % more (docs/validation/contact.md).
+/// and the tip deflects 11 % and 3.4 % more (docs/validation.md, "The paper's examples:
+/// regression pins").
 #[test]
 fn paper_examples_under_mortar_are_pinned() {
     // (pipeline, node-to-surface max |u|, mortar max |u|, its node tags, mortar Newton corrections)
@@ -119,14 +126,12 @@ fn paper_examples_under_mortar_are_pinned() {
         ("supported_beam", 0.79809336, 0.82502866, &[15], 118),
     ];
     for (name, u_node, u_pin, tag_pin, its_pin) in pins {
-        let dir = staged_meshes(&[&format!("{name}.msh")]);
-        let yaml = std::fs::read_to_string(repo().join(format!("pipelines/{name}.yaml"))).unwrap();
-        let mortar = yaml.replace("enforcement: augmented_lagrangian,", "enforcement: augmented_lagrangian, integration: mortar,");
-        assert!(mortar.contains("integration: mortar"), "{name}: no contact entry to change");
-        std::fs::write(dir.path().join(format!("pipelines/{name}.yaml")), mortar).unwrap();
-        let o = run("sc-pipeline", &[&format!("pipelines/{name}.yaml")], dir.path());
-        assert!(o.status.success(), "{name}: {}", stderr(&o));
-        let r = Results::read(&dir.path().join(format!("pipelines/out/{name}.scres"))).unwrap();
+        let mortar = |yaml: &str| {
+            let mortar = yaml.replace("enforcement: augmented_lagrangian,", "enforcement: augmented_lagrangian, integration: mortar,");
+            assert!(mortar.contains("integration: mortar"), "{name}: no contact entry to change");
+            mortar
+        };
+        let (r, _) = run_edited(name, mortar);
         assert_eq!(r.status, RunStatus::Completed, "{name}");
         let (u, tag) = max_displacement(&r);
         let its: usize = r.increments.iter().map(|i| i.info.iterations.len() - 1).sum();
