@@ -73,13 +73,19 @@ pub fn block(n: [usize; 3], l: [f64; 3], distort: f64) -> Mesh {
         face_sets.push(FaceSet { name: name.into(), physical_tag: 0, quad_tags: vec![0; fs.len()], faces: fs });
     }
     node_sets.push(NodeSet { name: "origin".into(), physical_tag: 0, dim: 0, nodes: vec![0] });
+    one_body("block", nodes, hexes, node_sets, face_sets)
+}
+
+/// A mesh of one body `name` (physical tag 1), gmsh tags 1, 2, … for its nodes and
+/// hexahedra.
+pub fn one_body(name: &str, nodes: Vec<[f64; 3]>, hexes: Vec<[u32; 8]>, node_sets: Vec<NodeSet>, face_sets: Vec<FaceSet>) -> Mesh {
     let m = hexes.len();
     Mesh {
         node_tags: (1..=nodes.len() as u64).collect(),
         nodes,
         hexes,
         hex_body: vec![0; m],
-        bodies: vec![Body { name: "block".into(), physical_tag: 1 }],
+        bodies: vec![Body { name: name.into(), physical_tag: 1 }],
         node_sets,
         face_sets,
         element_tags: (1..=m as u64).collect(),

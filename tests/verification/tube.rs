@@ -15,10 +15,10 @@
 //! The same model also carries the restart on an atlas master (cut and continued), the
 //! log's seam warnings, and `pipelines/tube.yaml` as shipped.
 
-use crate::common::grid::{block, two_bodies};
+use crate::common::grid::{block, one_body, two_bodies};
 use super::contact::{pair, run_contact};
 use splinecontact::format::sccontact::MasterKind;
-use splinecontact::mesh::{Body, FaceSet, HexFace, Mesh, NodeSet};
+use splinecontact::mesh::{FaceSet, HexFace, Mesh, NodeSet};
 
 /// A tube of `na` nodes around, `nr` elements through the wall and `nz` along z;
 /// node sets `inner` (r = r0), face set `outer` (r = r1, outward). Its nodes sit at
@@ -58,17 +58,9 @@ pub(super) fn ring(angles: &[f64], closed: bool, nr: usize, nz: usize, r0: f64, 
         }
     }
     let inner: Vec<u32> = (0..=nz).flat_map(|k| (0..na).map(move |j| id(0, j, k))).collect::<std::collections::BTreeSet<_>>().into_iter().collect();
-    let m = hexes.len();
-    Mesh {
-        node_tags: (1..=nodes.len() as u64).collect(),
-        nodes,
-        hexes,
-        hex_body: vec![0; m],
-        bodies: vec![Body { name: "tube".into(), physical_tag: 1 }],
-        node_sets: vec![NodeSet { name: "inner".into(), physical_tag: 0, dim: 2, nodes: inner }],
-        face_sets: vec![FaceSet { name: "outer".into(), physical_tag: 0, quad_tags: vec![0; outer.len()], faces: outer }],
-        element_tags: (1..=m as u64).collect(),
-    }
+    let node_sets = vec![NodeSet { name: "inner".into(), physical_tag: 0, dim: 2, nodes: inner }];
+    let face_sets = vec![FaceSet { name: "outer".into(), physical_tag: 0, quad_tags: vec![0; outer.len()], faces: outer }];
+    one_body("tube", nodes, hexes, node_sets, face_sets)
 }
 
 /// The tube (24 nodes around, r ∈ [2, 3], 2 elements through the wall and 2 along
