@@ -22,7 +22,7 @@
 use std::path::{Path, PathBuf};
 
 use crate::format::sccontact::ContactPair;
-use crate::format::scres::{Increment, Results};
+use crate::format::scres::{Increment, Results, RunStatus};
 use crate::format::stage::StageError;
 use crate::mesh::Mesh;
 
@@ -43,6 +43,10 @@ pub struct RestartPoint {
     pub increments: Vec<Increment>,
     /// Why its last bytes were left out, if they were (an interrupted write).
     pub tail: Option<String>,
+    /// The run that wrote it was interrupted (killed, or stopped by a failed
+    /// increment) after the increment continued from: it never marked itself
+    /// completed there.
+    pub interrupted: bool,
 }
 
 impl RestartPoint {
@@ -93,6 +97,7 @@ impl RestartPoint {
         if results.increments.is_empty() {
             return Err(mismatch("it holds no converged increment".into()));
         }
+        let interrupted = !matches!(results.status, RunStatus::Completed);
         match increment {
             Some(k) if k == 0 || k > results.increments.len() => {
                 return Err(mismatch(format!("it holds converged increments 1 to {}, not increment {k}", results.increments.len())));
@@ -100,7 +105,7 @@ impl RestartPoint {
             Some(k) => results.increments.truncate(k),
             None => {}
         }
-        Ok(Self { file: file.to_path_buf(), increments: results.increments, tail: results.tail })
+        Ok(Self { file: file.to_path_buf(), increments: results.increments, tail: results.tail, interrupted })
     }
 
     /// The last converged increment: the state to continue from.

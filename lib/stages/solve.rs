@@ -86,7 +86,10 @@ pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, 
     }
     let factors = setup.load_factors(setup_name)?;
     if let Some(point) = &point {
-        if point.remaining(&factors) == 0 {
+        // a run killed after its last increment converged but before it marked
+        // itself completed is finished here (nothing to solve, the status to write);
+        // a completed one asks for a longer load path
+        if point.remaining(&factors) == 0 && !point.interrupted {
             return Err(StageRunError::Usage(format!(
                 "{}: the run already reached load factor {:.6}, and the setup {setup_name} ends at {:.6}: nothing left to solve (extend the load path to continue)",
                 point.file.display(),
@@ -194,6 +197,9 @@ pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, 
         ));
         if let Some(t) = &point.tail {
             log.warning(&format!("{}: {t}", point.file.display()));
+        }
+        if point.remaining(&factors) == 0 {
+            log.line(&format!("{}: its run reached the end of the load path but was interrupted before it marked itself completed; this run marks it completed", point.file.display()));
         }
         results.increments = point.increments;
     }

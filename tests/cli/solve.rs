@@ -137,6 +137,20 @@ fn restart_continues_a_stopped_solve_into_its_own_file() {
     // nothing left: the finished run with the same setup
     let o = run("sc-solve", &["c.scmesh", "--setup", "setup.yaml", "-o", "again.scres", "--restart", "r.scres"], dir.path());
     assert_fails(&o, 2, &["r.scres", "already reached load factor 1.000000", "nothing left to solve"], &dir.path().join("again.scres"));
+    // killed after its last increment, before it marked itself completed: the
+    // restart only writes the status, and the increments stay bit for bit
+    let mut killed = r.clone();
+    killed.status = RunStatus::Running;
+    killed.write(&dir.path().join("killed.scres")).unwrap();
+    let o = run("sc-solve", &["c.scmesh", "--setup", "setup.yaml", "-o", "killed.scres", "--restart", "killed.scres"], dir.path());
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("interrupted before it marked itself completed; this run marks it completed"), "{err}");
+    let finished = Results::read(&dir.path().join("killed.scres")).unwrap();
+    assert_eq!(finished.status, RunStatus::Completed);
+    assert_eq!(finished.increments.len(), r.increments.len());
+    let bits = |r: &Results| r.increments.iter().flat_map(|i| i.u.iter().flatten().map(|x| x.to_bits())).collect::<Vec<_>>();
+    assert!(bits(&finished) == bits(&r), "the increments changed");
 }
 
 /// A restart file from another model, or not a results file: exit 2, the file named,
