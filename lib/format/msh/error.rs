@@ -10,7 +10,7 @@ pub enum MshError {
     Io { path: String, source: std::io::Error },
     #[error("{file}: not a gmsh MSH file: no $MeshFormat header{found}")]
     NotMsh { file: String, found: String },
-    #[error("{at}: MSH version {found} is not supported (supported: {supported}); re-export it from gmsh with `-format msh41` or `-format msh22`", supported = SUPPORTED)]
+    #[error("{at}: MSH version `{found}` is not supported (supported: {supported}); re-export it from gmsh with `-format msh41` or `-format msh22`", supported = SUPPORTED)]
     UnsupportedVersion { at: String, found: String },
     #[error("{at}: expected `{expected}` before end of file")]
     Truncated { at: String, expected: String },

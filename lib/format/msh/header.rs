@@ -142,7 +142,7 @@ mod tests {
     #[test]
     fn unknown_version_lists_the_supported_ones() {
         let e = header(b"$MeshFormat\n3.0 0 8\n$EndMeshFormat\n").unwrap_err().to_string();
-        assert_eq!(e, "t.msh:2: MSH version 3.0 is not supported (supported: 2.2, 4.1); re-export it from gmsh with `-format msh41` or `-format msh22`");
+        assert_eq!(e, "t.msh:2: MSH version `3.0` is not supported (supported: 2.2, 4.1); re-export it from gmsh with `-format msh41` or `-format msh22`");
     }
 
     #[test]

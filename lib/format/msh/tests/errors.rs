@@ -61,9 +61,9 @@ fn error_random_bytes() {
 #[test]
 fn error_unsupported_version() {
     let e = parse_err(b"$MeshFormat\n3.0 0 8\n$EndMeshFormat\n");
-    assert!(e.starts_with("t.msh:2: MSH version 3.0 is not supported (supported: 2.2, 4.1)"), "{e}");
+    assert!(e.starts_with("t.msh:2: MSH version `3.0` is not supported (supported: 2.2, 4.1)"), "{e}");
     let e = parse_err(b"$MeshFormat\n4 0 8\n$EndMeshFormat\n");
-    assert!(e.contains("version 4 is not supported (supported: 2.2, 4.1)"), "{e}");
+    assert!(e.contains("version `4` is not supported (supported: 2.2, 4.1)"), "{e}");
 }
 
 #[test]
