@@ -399,11 +399,33 @@ pub struct ResultsFile {
     /// Bytes written and seconds spent writing (encoding, writing, syncing).
     pub bytes: u64,
     pub seconds: f64,
+    /// Appends made so far (for the fault injection of [`kill_in_append`]).
+    appends: usize,
+}
+
+/// Fault injection for the crash tests: with `SC_FAULT_KILL_IN_APPEND=K:F` the K-th
+/// append (1-based) writes the first fraction F of its bytes, syncs them and sends
+/// SIGKILL to its own process: a kill inside `write`, landed where the test wants
+/// it instead of where chance puts it (`tests/verification/crash.rs`).
+fn kill_in_append(append: usize) -> Option<f64> {
+    let v = std::env::var("SC_FAULT_KILL_IN_APPEND").ok()?;
+    let (k, f) = v.split_once(':')?;
+    (k.trim().parse::<usize>().ok()? == append).then_some(())?;
+    f.trim().parse::<f64>().ok().filter(|f| (0.0..=1.0).contains(f))
+}
+
+/// SIGKILL this process (through `kill`, the standard tool: no signal crate for
+/// one test hook) and wait for it.
+fn kill_self() -> ! {
+    let _ = std::process::Command::new("kill").args(["-KILL", &std::process::id().to_string()]).status();
+    loop {
+        std::thread::sleep(std::time::Duration::from_secs(1));
+    }
 }
 
 impl ResultsFile {
     pub fn new(path: &Path) -> Self {
-        Self { path: path.to_path_buf(), open: None, written: 0, closed: false, bytes: 0, seconds: 0.0 }
+        Self { path: path.to_path_buf(), open: None, written: 0, closed: false, bytes: 0, seconds: 0.0, appends: 0 }
     }
 
     /// A results file that is never written (an MPI rank other than the first, which
@@ -432,6 +454,11 @@ impl ResultsFile {
                 let mut w = StageWriter::append_to(*end);
                 results.encode_tail(&mut w, self.written);
                 let (bytes, new_end) = w.finish_segments();
+                self.appends += 1;
+                if let Some(f) = kill_in_append(self.appends) {
+                    let _ = file.write_all(&bytes[..(bytes.len() as f64 * f) as usize]).and_then(|_| file.sync_data());
+                    kill_self();
+                }
                 file.write_all(&bytes).and_then(|_| file.sync_data()).map_err(|source| StageError::Io { path: self.path.display().to_string(), action: "append to", source })?;
                 self.bytes += bytes.len() as u64;
                 *end = new_end;

@@ -17,10 +17,11 @@
 //!   uninterrupted one reuses an older one, and the inexact Newton stops at the
 //!   residual tolerance, 1e-8; measured differences are printed).
 //!
-//! A kill lands inside an append only by chance, so the middle of a write is also
-//! covered exactly: the uninterrupted file cut at bytes inside every increment's
-//! segment (what a kill in `write` leaves) reads as the increments before the cut,
-//! and restarts complete from several of them.
+//! A timed kill lands inside an append only by chance, so the middle of a write is
+//! also covered exactly: the solver's fault injection (`SC_FAULT_KILL_IN_APPEND`)
+//! SIGKILLs it inside chosen appends, and the uninterrupted file cut at bytes
+//! inside every increment's segment (what a kill in `write` leaves) reads as the
+//! increments before the cut; restarts complete from them.
 //!
 //! `sc-import`, `sc-tag` and `sc-export` write through a temporary file renamed
 //! onto the target: killed at any moment, their output is absent or complete. A
@@ -202,6 +203,34 @@ fn a_results_file_cut_inside_any_increment_reads_and_restarts() {
         }
     }
     eprintln!("{cuts} cuts inside {} segments read back; restarts from 3 of them end within {worst:.2e} of max |u|", ends.len() - 1);
+}
+
+/// A real SIGKILL inside an append, at its start, middle and end, early and late in
+/// the run (`SC_FAULT_KILL_IN_APPEND=K:F`: the K-th append writes the fraction F of
+/// its bytes, syncs and kills its process). The file reads as the increments
+/// before that append, reports the partial segment, and a restart completes.
+#[test]
+fn a_kill_inside_an_append_keeps_the_increments_before_it() {
+    use std::os::unix::process::ExitStatusExt;
+    let (dir, model, setup) = model();
+    let d = dir.path();
+    let o = solve(d, &model, &setup, "full.scres", false).arg("-q").output().unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let full = Results::read(&d.join("full.scres")).unwrap();
+    let mut worst = 0.0f64;
+    for (k, f) in [(1, 0.5), (2, 0.0), (7, 0.99), (15, 0.5), (29, 0.01)] {
+        let out = format!("append{k}_{}.scres", (f * 100.0) as u32);
+        let o = solve(d, &model, &setup, &out, false).arg("-q").env("SC_FAULT_KILL_IN_APPEND", format!("{k}:{f}")).output().unwrap();
+        assert_eq!(o.status.signal(), Some(9), "append {k}: not killed: {:?} {}", o.status, stderr(&o));
+        let r = Results::read(&d.join(&out)).unwrap_or_else(|e| panic!("append {k} at {f}: unreadable: {e}"));
+        // the first write holds increment 1; append k adds increment k + 1
+        assert_eq!(r.increments.len(), k, "append {k} at {f}");
+        // nothing of the segment written (F = 0) leaves a whole file, one increment short
+        assert_eq!(r.tail.is_some(), f > 0.0, "append {k} at {f}: partial segment {:?}", r.tail);
+        assert_prefix(&r, &full, &format!("append {k} at {f}"));
+        worst = worst.max(restart_completes(d, &model, &setup, &out, &full));
+    }
+    eprintln!("5 kills inside appends; restarts end within {worst:.2e} of max |u|");
 }
 
 /// A killed `sc-import`, `sc-tag` or `sc-export` leaves no output, or a complete one.
