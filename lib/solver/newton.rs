@@ -427,6 +427,12 @@ impl<'p> Newton<'p> {
         self.pattern.nnz()
     }
 
+    /// A load increment's first attempt, or a cutback's next one, starts: the linear
+    /// solver keeps no preconditioner from before (restarts continue bit for bit).
+    pub fn begin_increment(&mut self) {
+        self.linear.begin_increment();
+    }
+
     pub fn linear_solver_name(&self) -> &str {
         self.linear.name()
     }

@@ -295,6 +295,11 @@ impl LinearSolver for SymmetricPartGmres {
         Ok(FactorInfo { method, time })
     }
 
+    fn begin_increment(&mut self) {
+        // the held S is not used again: the increment's first `factor` factors anew
+        self.held = None;
+    }
+
     fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolverError> {
         let Some(pattern) = self.pattern() else {
             return Err(LinearSolverError::Order("solve_in_place", "analyse"));

@@ -28,6 +28,7 @@ pub fn solve_augmented(newton: &mut Newton, lambda: f64, u: &mut [f64], on_itera
     let mut u_start = Vec::new();
     let mut update: Vec<(usize, Multipliers, Multipliers)> = Vec::new();
     let mut theta = 1.0;
+    newton.begin_increment();
     loop {
         let (halvings, searched) = (newton.step_halvings, newton.line_search_steps);
         let solved = newton.solve_increment(lambda, u, on_iteration);

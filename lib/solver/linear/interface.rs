@@ -91,6 +91,11 @@ pub trait LinearSolver: Send {
     /// displacement vector, before `factor` (a multigrid backend builds its
     /// rigid-body near-null space from them); others ignore it.
     fn set_configuration(&mut self, _reference: &[nalgebra::Vector3<f64>], _u: &[f64]) {}
+    /// A load increment (or a cutback's new attempt) starts: the next `factor`
+    /// keeps nothing from an earlier increment (no preconditioner reused across
+    /// it), so that a restart from any converged increment, which starts with
+    /// nothing kept, continues bit for bit. A direct backend has nothing to drop.
+    fn begin_increment(&mut self) {}
 }
 
 /// The checks every `factor(values)` makes: a pattern was analysed, `values` has one
