@@ -122,13 +122,18 @@ fn paper_examples_under_mortar_are_pinned() {
     // (pipeline, node-to-surface max |u|, mortar max |u|, its node tags, mortar Newton corrections)
     let pins: [(&str, f64, f64, &[u64], usize); 3] = [
         ("crossed_beams", 1.11427638, 1.23245042, &[15], 22),
-        ("parallel_beams", 0.33898814, 0.33764117, &[86, 87, 90, 91], 170),
+        ("parallel_beams", 0.33898814, 0.33775584, &[86, 87, 90, 91], 194),
         ("supported_beam", 0.79809336, 0.82502866, &[15], 118),
     ];
     for (name, u_node, u_pin, tag_pin, its_pin) in pins {
         let mortar = |yaml: &str| {
-            let mortar = yaml.replace("enforcement: augmented_lagrangian,", "enforcement: augmented_lagrangian, integration: mortar,");
+            let mut mortar = yaml.replace("enforcement: augmented_lagrangian,", "enforcement: augmented_lagrangian, integration: mortar,");
             assert!(mortar.contains("integration: mortar"), "{name}: no contact entry to change");
+            if name == "parallel_beams" {
+                // the paper's 30 increments stall under mortar near λ = 0.48 (docs/validation.md)
+                mortar = mortar.replace("increments: {count: 30, max_cutbacks: 5}", "increments: {count: 60, max_cutbacks: 5}\n        linear_solver: lu");
+                assert!(mortar.contains("count: 60"), "{name}: no increments entry to change");
+            }
             mortar
         };
         let (r, _) = run_edited(name, mortar);
