@@ -204,3 +204,19 @@ fn multipatch_next_to_a_seam_and_free_facets() {
     check("free facets", Atlas::facets(xu.len(), faces.clone()), &xu, 0, [0.3, 0.6]);
     check("free facets", Atlas::facets(xu.len(), faces), &xu, 3, [0.7, 0.2]);
 }
+
+/// A held knot span (the frozen search on a C⁰ patch, order 2 along ξ¹): the foot
+/// point lies a fifth of a span beyond the held span's end, on its polynomial
+/// continued across the knot line, where the neighbouring span meets it at a kink.
+/// The element sees one smooth map there, and its tangent is that map's.
+#[test]
+fn held_span_beyond_a_c0_knot_line() {
+    let (na, nb) = (7, 5);
+    let x: Vec<Vec3> = tube(na + 3, nb).into_iter().enumerate().filter(|(k, _)| k % (na + 3) < na).map(|(_, p)| p).collect();
+    let nodes: Vec<u32> = (0..(na * nb) as u32).collect();
+    let atlas = Atlas::splines(na * nb, &[SheetNet { a: na, b: nb, nodes: &nodes }], [2, 3], false).unwrap();
+    // chart 2 + (na − 1)·1: the third span along ξ¹ in the second row of spans
+    let chart = 2 + (na - 1);
+    check("order 2 held span, beyond its end", atlas.clone(), &x, chart, [1.2, 0.4]);
+    check("order 2 held span, before its start", atlas, &x, chart, [-0.2, 0.6]);
+}

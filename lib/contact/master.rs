@@ -5,7 +5,8 @@
 //! the mortar integration.
 //!
 //! The master element of a foot point (`cell`) is the facet cell `[i, j]` on a
-//! facet net and `[chart, 0]` on an atlas; a single B-spline patch has none.
+//! facet net and `[chart, 0]` on an atlas; a single B-spline patch has none, except
+//! while a frozen search holds the knot span `[s, t]` a foot point lies in.
 
 use crate::contact::{MasterNet, NetShape};
 use crate::format::sccontact::MasterKind;
@@ -77,10 +78,11 @@ impl Projector {
 
     /// With the master element held (a frozen search): a facet slave projects onto
     /// its last cell's continued bilinear map, a slave in crease contact onto the same
-    /// crease (`last`: its previous projection); a B-spline slave as usual (the patch
-    /// is one smooth map, there is no element to hold).
+    /// crease (`last`: its previous projection); a B-spline slave onto the knot span
+    /// it was held in (its polynomial continued), or as usual when none is held.
     pub fn project_frozen(&self, p: &Vec3, prev: Option<[usize; 2]>, last: &Projection) -> (Projection, Option<[usize; 2]>) {
         match (self, prev) {
+            (Self::BSpline(pr), Some(span)) => (pr.project_in_span(p, last.xi, span), Some(span)),
             (Self::Facet(pr), Some(c)) => {
                 let crease = [0, 1].map(|al| last.clamped[al].then_some(last.xi[al]));
                 let (proj, cell) = pr.project_on_cell(p, c, crease);
@@ -107,7 +109,8 @@ impl Projector {
     }
     pub fn evaluate(&self, xi: [f64; 2], cell: Option<[usize; 2]>) -> SurfacePoint {
         match (self, cell) {
-            (Self::BSpline(p), _) => p.evaluate(xi),
+            (Self::BSpline(p), None) => p.evaluate(xi),
+            (Self::BSpline(p), Some(span)) => p.evaluate_in_span(xi, span),
             (Self::Facet(p), Some(c)) => p.evaluate_in_cell(xi, c),
             (Self::Facet(p), None) => p.evaluate(xi),
             (Self::Atlas(p), c) => p.evaluate(c.map_or(0, |c| c[0]), xi),
@@ -128,6 +131,24 @@ impl Projector {
         let up = old.a_inv * nalgebra::Vector2::new(t_t_n[0], t_t_n[1]);
         let t = old.a_alpha[0] * up[0] + old.a_alpha[1] * up[1];
         (xi, [t.dot(&new.a_alpha[0]), t.dot(&new.a_alpha[1])])
+    }
+
+    /// The knot span of a single patch's foot point at `xi`, the element a frozen
+    /// search holds; `None` on other masters (their cells come from the search).
+    pub fn span_of(&self, xi: [f64; 2]) -> Option<[usize; 2]> {
+        match self {
+            Self::BSpline(pr) if xi.iter().all(|x| x.is_finite()) => Some(pr.patch().span_of(xi)),
+            _ => None,
+        }
+    }
+
+    /// Whether the single patch is C⁰ somewhere (order 2 with an interior knot):
+    /// there the spans meet at kinks that a frozen search holds the slaves on.
+    pub fn has_kinks(&self) -> bool {
+        match self {
+            Self::BSpline(pr) => (0..2).any(|al| pr.patch().orders()[al] == 2 && pr.patch().n_spans()[al] > 1),
+            _ => false,
+        }
     }
 
     /// Charts of an atlas (1 for other masters).

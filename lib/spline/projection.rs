@@ -208,6 +208,26 @@ impl BSplineProjector {
         finish(p, &res, o.outside_tol * self.scale)
     }
 
+    /// Closest point on span `span`'s polynomial, continued beyond the span (a held
+    /// master element: the frozen search of a contact pair), Newton from `xi0`
+    /// within the patch's domain. Where the patch is C⁰ (order 2) the spans on
+    /// either side of a knot line meet at a kink; held on one of them, the residual
+    /// and its tangent stay one smooth function.
+    pub fn project_in_span(&self, p: &Vec3, xi0: [f64; 2], span: [usize; 2]) -> Projection {
+        let ns = self.patch.n_spans();
+        let o = &self.options;
+        let max_step = [o.max_step_spans / ns[0] as f64, o.max_step_spans / ns[1] as f64];
+        let res = newton(|xi| self.patch.jet_in_span(&self.x, xi, span), p, xi0, ([0.0; 2], [1.0; 2]), max_step, o.tol * self.scale, o.max_iterations);
+        finish(p, &res, o.outside_tol * self.scale)
+    }
+
+    /// Full evaluation at ξ with span `span`'s polynomial.
+    pub fn evaluate_in_span(&self, xi: [f64; 2], span: [usize; 2]) -> SurfacePoint {
+        let mut out = SurfacePoint::default();
+        self.patch.evaluate_in_span_into(&self.x, xi, span, &mut out);
+        out
+    }
+
     /// Step 2 span by span: Newton bounded to each candidate span of the tree
     /// (branch and bound on the best distance found), the nearest result wins.
     fn project_by_spans(&self, p: &Vec3) -> Projection {
@@ -353,6 +373,34 @@ pub(crate) mod tests {
                 }
             }
         }
+    }
+
+    /// A held span (the frozen search): inside its span a point projects as without
+    /// it; on a C⁰ patch (order 2, the wavy net's kinks) a point whose foot lies in
+    /// the next span projects onto the held span's plane continued, which passes
+    /// through the shared knot line's points, and the evaluation there matches the
+    /// held span's polynomial, not the global one.
+    #[test]
+    fn a_held_span_continues_its_polynomial() {
+        let n = 6;
+        let x = wavy_square_net(n);
+        let proj = BSplineProjector::new(BSplinePatch::new(n, n, 2, 2).unwrap(), &x).unwrap();
+        let inside = Vec3::new(1.3, 2.6, 1.0);
+        let free = proj.project(&inside);
+        let span = proj.patch().span_of(free.xi);
+        let held = proj.project_in_span(&inside, free.xi, span);
+        assert!(held.converged && (held.x_bar - free.x_bar).norm() < 1e-12, "{held:?} vs {free:?}");
+        // a point over the next span along ξ¹, held on this one
+        let next = Vec3::new(2.4, 2.6, 1.0);
+        let free_next = proj.project(&next);
+        assert_eq!(proj.patch().span_of(free_next.xi)[0], span[0] + 1);
+        let held_next = proj.project_in_span(&next, free.xi, span);
+        assert!(held_next.converged);
+        assert!(held_next.xi[0] > proj.patch().knots(0).span_bounds(span[0]).1, "the held foot lies beyond its span: {held_next:?}");
+        let on_held = proj.evaluate_in_span(held_next.xi, span);
+        let global = proj.evaluate(held_next.xi);
+        assert!((on_held.x_bar - held_next.x_bar).norm() < 1e-12);
+        assert!((global.x_bar - on_held.x_bar).norm() > 1e-6, "the held span's continuation is the global surface: no kink tested");
     }
 
     /// 9 × 5 nodes on a cylinder of radius R about the y axis, angle 0…π/2 along ξ¹.

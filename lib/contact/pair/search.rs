@@ -197,7 +197,11 @@ impl PairSolver {
     /// facets of a crease makes the residual non-differentiable there and Newton
     /// cycles); with the elements held, the remaining iterations see one smooth
     /// residual and converge, and the next solve searches afresh (the "segment
-    /// update" limit of FEBio and others). B-spline masters have no elements to hold.
+    /// update" limit of FEBio and others). A single B-spline patch holds each
+    /// slave's knot span where the patch is C⁰ (order 2): on a knot line the
+    /// one-sided derivatives of the basis differ, and a slave on it flips between
+    /// the spans by round-off (docs/validation/masters.md, the knot-line row). A
+    /// patch that is C¹ everywhere has no element to hold.
     ///
     /// With friction the return mapping's branch of every pressed slave (stick or
     /// slip, eq. 4.8 at the last search) is held as well, so a node at the slip
@@ -209,6 +213,11 @@ impl PairSolver {
     pub fn freeze(&mut self) {
         self.frozen = true;
         self.segmentation_held = self.mortar.is_some();
+        if self.mortar.is_none() && self.projector.has_kinks() {
+            for (cell, p) in self.cells.iter_mut().zip(&self.projections) {
+                *cell = if p.converged { self.projector.span_of(p.xi) } else { None };
+            }
+        }
         if self.settings.frictional() {
             for s in 0..self.slaves.len() {
                 self.held_slip[s] = None;
@@ -224,6 +233,10 @@ impl PairSolver {
 
     /// Let the search choose master elements (and the return mapping its branch) again.
     pub fn release(&mut self) {
+        if self.projector.has_kinks() {
+            // a single patch's spans were held only while frozen
+            self.cells.iter_mut().for_each(|c| *c = None);
+        }
         self.frozen = false;
         self.segmentation_held = false;
         self.held_slip.iter_mut().for_each(|h| *h = None);
@@ -243,9 +256,9 @@ impl PairSolver {
     }
 
     /// Whether freezing holds anything (facet and atlas masters: their elements and
-    /// crease contact; frictional pairs).
+    /// crease contact; a single patch's spans where it is C⁰; frictional pairs).
     pub fn can_freeze(&self) -> bool {
-        matches!(self.projector, Projector::Facet(_) | Projector::Atlas(_)) || self.settings.frictional() || self.mortar.is_some()
+        matches!(self.projector, Projector::Facet(_) | Projector::Atlas(_)) || (self.mortar.is_none() && self.projector.has_kinks()) || self.settings.frictional() || self.mortar.is_some()
     }
 
     /// The slave has a foot point on the patch: inside, or beyond an edge by less
