@@ -133,6 +133,16 @@ impl Projector {
         (xi, [t.dot(&new.a_alpha[0]), t.dot(&new.a_alpha[1])])
     }
 
+    /// `fraction` of a span (of a chart, on an atlas) in the parameter units of
+    /// [`Self::project_extended`]'s margin (smooth masters; a facet net: none).
+    pub fn span_margin(&self, fraction: f64) -> [f64; 2] {
+        match self {
+            Self::BSpline(pr) => pr.patch().n_spans().map(|n| fraction / n as f64),
+            Self::Facet(_) => [0.0; 2],
+            Self::Atlas(_) => [fraction; 2],
+        }
+    }
+
     /// The knot span of a single patch's foot point at `xi`, the element a frozen
     /// search holds; `None` on other masters (their cells come from the search).
     pub fn span_of(&self, xi: [f64; 2]) -> Option<[usize; 2]> {

@@ -509,9 +509,24 @@ fn project_point(geometry: &Projector, trace: &Trace, x: &Vec3, cell: usize, sta
         Projector::BSpline(pr) => (start.xi.map_or_else(|| pr.project(x), |xi0| pr.project_warm(x, xi0)), None),
         _ => geometry.project_near(x, start.element.zip(start.xi)),
     };
-    if !(p.converged && p.inside) {
+    if !p.converged {
         return None;
     }
+    let p = if p.inside {
+        p
+    } else {
+        // The point lies on a segment, so over a trace cell; at the master's edge the
+        // smooth surface's own edge curve may pass inside the facet's edge. Its foot
+        // on the surface's extension (half a span at most) keeps the integrand
+        // continuous as quadrature points cross that curve: cut off there, each
+        // crossing drops ε_N w g from the residual, and Newton chatters (the
+        // parallel beams under mortar stalled so).
+        let ext = geometry.project_extended(x, p.xi, element, geometry.span_margin(0.5));
+        if !ext.converged || !ext.inside {
+            return None;
+        }
+        ext
+    };
     let t = trace.project_on_cell(x, cell)?;
     Some(Foot { xi: p.xi, element, zeta: t.xi, g: p.g })
 }
