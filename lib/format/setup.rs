@@ -95,7 +95,8 @@ impl Components {
 }
 
 /// A Dirichlet condition on a node set: `fix` components to zero and/or prescribe
-/// `displacement` components (scaled by the load factor).
+/// `displacement` components (scaled by the load factor), or move the set rigidly:
+/// `rotation` (about a fixed axis, after the `displacement` translation).
 #[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct ConstraintSetup {
@@ -107,6 +108,25 @@ pub struct ConstraintSetup {
     pub displacement: Option<Components>,
     /// Amplitude of `displacement` over the load factor ("time") t: a name from
     /// `curves`; default the ramp a(t) = t.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub curve: Option<String>,
+    #[serde(default)]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rotation: Option<RotationSetup>,
+}
+
+/// A prescribed finite rotation of a node set by `angle` (radians, at amplitude 1)
+/// about the axis through `center` along `axis` (right-handed): every node goes to
+/// x = c + R(θ a(t)) (X + d(t) − c), d the constraint's `displacement` (all three
+/// components prescribed; missing ones are zero).
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct RotationSetup {
+    pub axis: [f64; 3],
+    #[serde(default)]
+    pub center: [f64; 3],
+    pub angle: f64,
+    /// Amplitude of the angle: a name from `curves`; default the ramp a(t) = t.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub curve: Option<String>,
 }

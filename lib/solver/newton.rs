@@ -524,9 +524,7 @@ impl<'p> Newton<'p> {
     /// converged state), which is updated in place. `on_iteration` sees each row.
     pub fn solve_increment(&mut self, lambda: f64, u: &mut [f64], on_iteration: &mut dyn FnMut(&IterationLog)) -> Result<Converged, IncrementFailure> {
         let p = self.problem;
-        for pr in &p.prescribed {
-            u[pr.dof] = p.amplitudes[pr.amplitude as usize].at(lambda) * pr.value;
-        }
+        p.apply_prescribed(lambda, u);
         p.external_force(lambda, &mut self.f_ext);
         let ratio = cutback_ratio(self.planned_step, lambda - self.lambda_n);
         if let Some(s) = &mut self.stabilization {

@@ -60,6 +60,30 @@ pub struct Prescribed {
     pub amplitude: u32,
 }
 
+/// A node set moved rigidly (eq.: x = c + R(θ a_θ(t)) (X + d a_d(t) − c)): every
+/// component of its nodes is prescribed. R is Rodrigues' rotation about the unit
+/// `axis`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PrescribedRotation {
+    pub nodes: Vec<u32>,
+    pub axis: Vector3<f64>,
+    pub center: Vector3<f64>,
+    pub angle: f64,
+    /// Index into `Problem::amplitudes`, of the angle.
+    pub amplitude: u32,
+    /// The translation applied before the rotation, and its amplitude.
+    pub translation: Vector3<f64>,
+    pub translation_amplitude: u32,
+}
+
+impl PrescribedRotation {
+    /// u of reference point `x` at angle amplitude `a` and translation amplitude `b`.
+    pub fn displacement(&self, x: &Vector3<f64>, a: f64, b: f64) -> Vector3<f64> {
+        let r = nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_unchecked(self.axis), self.angle * a);
+        self.center + r * (x + self.translation * b - self.center) - x
+    }
+}
+
 /// The problem.
 pub struct Problem {
     /// Reference coordinates.
@@ -72,6 +96,8 @@ pub struct Problem {
     pub dofs: DofMap,
     /// Nonzero prescribed displacement components.
     pub prescribed: Vec<Prescribed>,
+    /// Node sets moved rigidly ([`Self::apply_prescribed`] sets their dofs).
+    pub rotations: Vec<PrescribedRotation>,
     /// Amplitudes: 0 is the ramp a(t) = t, then the setup's curves in order.
     pub amplitudes: Vec<Amplitude>,
     /// External nodal forces at amplitude 1, per amplitude (empty when none uses it),
@@ -316,10 +342,41 @@ impl Problem {
         let mut constrained = vec![false; DOFS_PER_NODE * n];
         let mut value = vec![0.0; DOFS_PER_NODE * n];
         let mut reaction_sets = Vec::new();
+        let mut rotations = Vec::new();
         for c in &setup.constraints {
             let set = mesh.node_set(&c.set).ok_or_else(|| unknown("node set", &c.set, mesh.node_set_names()))?;
             let prescribed = c.displacement.as_ref().map(|d| d.as_array()).unwrap_or_default();
             let amp = amplitude_of(&c.curve, &format!("the constraint on '{}'", c.set))?;
+            if let Some(r) = &c.rotation {
+                if !c.fix.is_empty() {
+                    return Err(invalid(format!("constraint on '{}': `rotation` prescribes every component, so `fix` cannot be given with it", c.set)));
+                }
+                let axis = Vector3::from(r.axis);
+                let finite = r.axis.iter().chain(&r.center).all(|v| v.is_finite()) && r.angle.is_finite() && prescribed.iter().flatten().all(|v| v.is_finite());
+                if !finite {
+                    return Err(invalid(format!("constraint on '{}': the rotation's axis, center, angle and the displacement must be finite", c.set)));
+                }
+                if axis.norm() == 0.0 {
+                    return Err(invalid(format!("constraint on '{}': the rotation axis [0, 0, 0] has no direction", c.set)));
+                }
+                let rotation_amplitude = amplitude_of(&r.curve, &format!("the rotation of '{}'", c.set))?;
+                for &node in &set.nodes {
+                    for i in 0..DOFS_PER_NODE {
+                        constrained[DOFS_PER_NODE * node as usize + i] = true;
+                    }
+                }
+                rotations.push(PrescribedRotation {
+                    nodes: set.nodes.clone(),
+                    axis: axis / axis.norm(),
+                    center: Vector3::from(r.center),
+                    angle: r.angle,
+                    amplitude: rotation_amplitude,
+                    translation: Vector3::from(prescribed.map(|v| v.unwrap_or(0.0))),
+                    translation_amplitude: amp,
+                });
+                reaction_sets.push((c.set.clone(), set.nodes.clone()));
+                continue;
+            }
             if c.fix.is_empty() && prescribed.iter().all(Option::is_none) {
                 return Err(invalid(format!("constraint on '{}' fixes nothing: give `fix` and/or `displacement`", c.set)));
             }
@@ -407,6 +464,7 @@ impl Problem {
             },
             dofs,
             prescribed,
+            rotations,
             amplitudes,
             f_ext,
             pressure_faces,
@@ -415,6 +473,22 @@ impl Problem {
             node_tags: mesh.node_tags.clone(),
             adjustments,
         })
+    }
+
+    /// The prescribed displacements at load factor `lambda` into `u`: each
+    /// component u[dof] = value · a(t), then the rigidly moved sets (a node in a
+    /// moved set takes the set's motion, whatever else names it).
+    pub fn apply_prescribed(&self, lambda: f64, u: &mut [f64]) {
+        for pr in &self.prescribed {
+            u[pr.dof] = self.amplitudes[pr.amplitude as usize].at(lambda) * pr.value;
+        }
+        for r in &self.rotations {
+            let (a, b) = (self.amplitudes[r.amplitude as usize].at(lambda), self.amplitudes[r.translation_amplitude as usize].at(lambda));
+            for &n in &r.nodes {
+                let d = r.displacement(&self.X[n as usize], a, b);
+                u[DOFS_PER_NODE * n as usize..DOFS_PER_NODE * n as usize + 3].copy_from_slice(d.as_slice());
+            }
+        }
     }
 
     /// f_ext(t) = Σ_a a(t) f_ext[a] into `out` (length 3·nodes).

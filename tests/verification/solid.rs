@@ -132,6 +132,42 @@ fn total_and_updated_lagrangian_agree() {
     assert!(diff < 1e-8 * scale, "TL and UL differ by {diff:e} (max |u| {scale})");
 }
 
+/// The `rotation` constraint (setup YAML): a node set of three corners turned by
+/// 120° about the axis (1, 1, 1) through the block's centre after a translation
+/// d = (0.3, −0.2, 0.1), in 24 increments through the whole solve. Every node ends at
+/// x = c + R(X + d − c) (u to 1e-10), the stress stays at round-off, and the
+/// reaction on the set is zero: a rigid motion needs no force. A rotation with
+/// `fix`, or about a zero axis, is refused naming the set.
+#[test]
+fn rotation_constraint_moves_a_set_rigidly() {
+    let mut mesh = block([2, 2, 2], [1.0, 1.0, 1.0], 0.25);
+    add_node_set(&mut mesh, "three", |x| x == &[0.0, 0.0, 0.0] || x == &[1.0, 0.0, 0.0] || x == &[0.0, 1.0, 1.0]);
+    let yaml = "materials: [{body: block, model: neo_hookean, E: 1000.0, nu: 0.3}]\n\
+        constraints:\n  - {set: three, displacement: {x: 0.3, y: -0.2, z: 0.1}, rotation: {axis: [1, 1, 1], center: [0.5, 0.5, 0.5], angle: 2.0943951023931953}}\n\
+        increments: {count: 24}\nnewton: {residual_tolerance: 1.0e-10}\n";
+    let r = run(&mesh, yaml);
+    let u = &r.increments.last().unwrap().u;
+    let axis = nalgebra::Unit::new_normalize(nalgebra::Vector3::new(1.0, 1.0, 1.0));
+    let rot = nalgebra::Rotation3::from_axis_angle(&axis, 2.0 * std::f64::consts::PI / 3.0);
+    let (c, d) = (nalgebra::Vector3::new(0.5, 0.5, 0.5), nalgebra::Vector3::new(0.3, -0.2, 0.1));
+    for (n, x) in mesh.nodes.iter().enumerate() {
+        let x = nalgebra::Vector3::from(*x);
+        let expect = c + rot * (x + d - c) - x;
+        for i in 0..3 {
+            assert!((u[n][i] - expect[i]).abs() < 1e-10, "node {n}: u = {:?}, expected {expect:?}", u[n]);
+        }
+    }
+    let worst = r.increments.last().unwrap().stress.iter().flatten().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+    assert!(worst < 1e-9 * 1000.0, "stress after a rigid motion: {worst:e}");
+    let reaction = &r.increments.last().unwrap().info.reactions[0];
+    assert!(reaction.force.iter().all(|f| f.abs() < 1e-8), "{reaction:?}");
+    // refusals
+    let e = try_run(&mesh, &yaml.replace("displacement: {x: 0.3, y: -0.2, z: 0.1}", "fix: [x]")).unwrap_err();
+    assert!(e.contains("constraint on 'three': `rotation` prescribes every component, so `fix` cannot be given with it"), "{e}");
+    let e = try_run(&mesh, &yaml.replace("axis: [1, 1, 1]", "axis: [0, 0, 0]")).unwrap_err();
+    assert!(e.contains("constraint on 'three': the rotation axis [0, 0, 0] has no direction"), "{e}");
+}
+
 /// Rigid rotation of 90° about z in 18 increments, imposed on three nodes only: the
 /// free nodes follow the rotation and the stress stays at round-off.
 #[test]
