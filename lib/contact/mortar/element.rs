@@ -436,7 +436,7 @@ mod tests {
         let mut x_all: Vec<Vec3> = x_net.clone();
         x_all.extend(&x_slave);
         let mut pr = master.projector(x_net);
-        let mut mortar = Mortar::new(&faces, &slaves, &x_all, &master.net, multipliers, transfer).unwrap().unwrap();
+        let mut mortar = Mortar::new(&faces, &slaves, &x_all, &master.net, multipliers, transfer, f64::INFINITY).unwrap().unwrap();
         let foot: Vec<_> = x_slave.iter().map(|x| pr.project(x, None)).collect();
         let foot_points: Vec<_> = foot.iter().map(|(p, c)| pr.evaluate(p.xi, *c)).collect();
         let (foot, foot_cells): (Vec<_>, Vec<_>) = foot.into_iter().unzip();

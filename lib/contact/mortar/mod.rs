@@ -114,8 +114,8 @@ pub struct Mortar {
     pub transfer: Transfer,
     /// A face whose corners' own foot points all lie farther than this in front of
     /// the master is not integrated (no slave node near it can be pressed; the
-    /// pair sets twice its capture distance, default: every face is integrated).
-    pub far: f64,
+    /// pair passes twice its capture distance, infinity integrates every face).
+    far: f64,
     /// Mesh node of every control point, and of every slave.
     net: Vec<u32>,
     slaves: Vec<u32>,
@@ -133,8 +133,10 @@ pub enum MortarError {
 impl Mortar {
     /// `faces`: the slave faces as mesh node ids (cycle order); `slaves`: the pair's
     /// slave nodes (sorted); `x_ref`: reference coordinates of all mesh nodes;
-    /// `net`: the master control net (any shape).
-    pub fn new(faces: &[[u32; 4]], slaves: &[u32], x_ref: &[Vec3], net: &MasterNet, multipliers: Multipliers, transfer: Transfer) -> Result<Result<Self, MortarError>, SplineError> {
+    /// `net`: the master control net (any shape); `far`: faces whose corners all lie
+    /// farther than this in front of the master are not integrated (the field `far`,
+    /// `f64::INFINITY`: every face is).
+    pub fn new(faces: &[[u32; 4]], slaves: &[u32], x_ref: &[Vec3], net: &MasterNet, multipliers: Multipliers, transfer: Transfer, far: f64) -> Result<Result<Self, MortarError>, SplineError> {
         let x_net: Vec<Vec3> = net.nodes.iter().map(|&n| x_ref[n as usize]).collect();
         let trace = Trace::new(net, &x_net)?;
         let mut local = Vec::with_capacity(faces.len());
@@ -172,7 +174,7 @@ impl Mortar {
             nodes: vec![Vec::new(); n],
             skipped_cells: 0,
             transfer,
-            far: f64::INFINITY,
+            far,
             net: net.nodes.clone(),
             slaves: slaves.to_vec(),
         }))

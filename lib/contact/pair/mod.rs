@@ -170,16 +170,13 @@ impl PairSolver {
                     &pair.net,
                     settings.multipliers,
                     settings.transfer,
+                    // faces farther than twice the capture distance are not integrated (`Mortar::far`)
+                    h_master,
                 )
                     .map_err(err)?
                     .map_err(|source| PairError::Mortar { pair: pair.name.clone(), source })?,
             ),
         };
-        // faces farther than twice the capture distance are not integrated (`Mortar::far`)
-        let mortar = mortar.map(|mut m| {
-            m.far = h_master;
-            m
-        });
         Ok(Self {
             name: pair.name.clone(),
             settings,

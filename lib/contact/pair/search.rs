@@ -60,6 +60,25 @@ fn project_slave(projector: &Projector, frozen: bool, edge_tolerance: f64, xs: &
     }
 }
 
+/// `f(s, projection, surface point, cell, x, node)` for every slave `s` of a pair, in
+/// parallel (chunks of at least 64 slaves): the search's per-slave arrays walked
+/// together, in place.
+#[inline]
+fn for_each_slave<F>(projections: &mut [Projection], points: &mut [SurfacePoint], cells: &mut [Option<[usize; 2]>], x_slave: &[Vec3], slaves: &[u32], f: F)
+where
+    F: Fn(usize, &mut Projection, &mut SurfacePoint, &mut Option<[usize; 2]>, &Vec3, u32) + Sync + Send,
+{
+    projections
+        .par_iter_mut()
+        .zip(points.par_iter_mut())
+        .zip(cells.par_iter_mut())
+        .zip(x_slave.par_iter())
+        .zip(slaves.par_iter())
+        .enumerate()
+        .with_min_len(64)
+        .for_each(|(s, ((((proj, sp), cell), xs), &node))| f(s, proj, sp, cell, xs, node));
+}
+
 /// A search shared by several MPI ranks ([`PairSolver::search_shared`]): each
 /// projects the slave nodes `mine` says are its own, and `exchange` sums a buffer
 /// over the ranks (every rank passes the same length).
@@ -130,18 +149,11 @@ impl PairSolver {
         self.x_slave.iter_mut().zip(&self.slaves).for_each(|(xs, &node)| *xs = x(node));
         let mine = share.as_ref().map(|s| s.mine);
         let is_mine = |node: u32| mine.is_none_or(|m| m(node));
-        self.projections
-            .par_iter_mut()
-            .zip(self.points.par_iter_mut())
-            .zip(self.cells.par_iter_mut())
-            .zip(self.x_slave.par_iter())
-            .zip(self.slaves.par_iter())
-            .with_min_len(64)
-            .for_each(|((((proj, sp), cell), xs), &node)| {
-                if is_mine(node) {
-                    project_slave(projector, frozen, edge_tolerance, xs, proj, sp, cell);
-                }
-            });
+        for_each_slave(&mut self.projections, &mut self.points, &mut self.cells, &self.x_slave, &self.slaves, |_, proj, sp, cell, xs, node| {
+            if is_mine(node) {
+                project_slave(projector, frozen, edge_tolerance, xs, proj, sp, cell);
+            }
+        });
         if let Some(share) = share {
             let n = self.slaves.len();
             self.exchange.clear();
@@ -151,25 +163,17 @@ impl PairSolver {
             }
             (share.exchange)(&mut self.exchange).map_err(|message| PairError::Exchange { pair: self.name.clone(), message })?;
             let exchange = &self.exchange;
-            self.projections
-                .par_iter_mut()
-                .zip(self.points.par_iter_mut())
-                .zip(self.cells.par_iter_mut())
-                .zip(self.x_slave.par_iter())
-                .zip(self.slaves.par_iter())
-                .enumerate()
-                .with_min_len(64)
-                .for_each(|(s, ((((proj, sp), cell), xs), &node))| {
-                    if is_mine(node) {
-                        return;
-                    }
-                    (*proj, *cell) = unpack(&exchange[PACKED * s..PACKED * (s + 1)]);
-                    if proj.converged {
-                        // what the owner's search left in its surface point
-                        *sp = projector.evaluate(proj.xi, *cell);
-                        sp.hold_on_crease(xs, proj.clamped);
-                    }
-                });
+            for_each_slave(&mut self.projections, &mut self.points, &mut self.cells, &self.x_slave, &self.slaves, |s, proj, sp, cell, xs, node| {
+                if is_mine(node) {
+                    return;
+                }
+                (*proj, *cell) = unpack(&exchange[PACKED * s..PACKED * (s + 1)]);
+                if proj.converged {
+                    // what the owner's search left in its surface point
+                    *sp = projector.evaluate(proj.xi, *cell);
+                    sp.hold_on_crease(xs, proj.clamped);
+                }
+            });
         }
         if let Some(mortar) = self.mortar.as_mut().filter(|_| self.segmentation_held) {
             mortar.refresh(&self.projector, &self.x_net, &self.x_slave, Feet { projections: &self.projections, elements: &self.cells, points: &self.points }, &self.areas).map_err(|source| PairError::Master { pair: self.name.clone(), source })?;

@@ -11,7 +11,7 @@
 //! ([`super::block_rows`]: constrained rows are `d·I`), each rank owning a
 //! contiguous range of nodes ([`super::ranks::owned_nodes`]) and inserting only
 //! those block rows. Under MPI each rank's Newton assembles every element that
-//! touches its nodes (`newton::Partition`), so its rows are complete and nothing is
+//! touches its nodes (`newton::partition::Partition`), so its rows are complete and nothing is
 //! shipped at assembly. GAMG rejects block-AIJ (BAIJ) in PETSc 3.18; AIJ with block
 //! size 3 still gets node aggregation and inode kernels.
 //!
