@@ -221,7 +221,8 @@ fn a_kill_inside_an_append_keeps_the_increments_before_it() {
     for (k, f) in [(1, 0.5), (2, 0.0), (7, 0.99), (15, 0.5), (29, 0.01)] {
         let out = format!("append{k}_{}.scres", (f * 100.0) as u32);
         let o = solve(d, &model, &setup, &out, false).arg("-q").env("SC_FAULT_KILL_IN_APPEND", format!("{k}:{f}")).output().unwrap();
-        assert_eq!(o.status.signal(), Some(9), "append {k}: not killed: {:?} {}", o.status, stderr(&o));
+        // SIGKILL, or SIGABRT where no `kill` tool exists: either stops the process dead
+        assert!(matches!(o.status.signal(), Some(9) | Some(6)), "append {k}: not killed: {:?} {}", o.status, stderr(&o));
         let r = Results::read(&d.join(&out)).unwrap_or_else(|e| panic!("append {k} at {f}: unreadable: {e}"));
         // the first write holds increment 1; append k adds increment k + 1
         assert_eq!(r.increments.len(), k, "append {k} at {f}");
