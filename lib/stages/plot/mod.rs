@@ -117,6 +117,8 @@ pub enum PlotError {
     BadSize { width: u32, height: u32 },
     #[error("{what} [{lo}, {hi}]: needs finite lo < hi")]
     BadRange { what: String, lo: f64, hi: f64 },
+    #[error("{what} reaches {value:e}: beyond what can be drawn (|v| ≤ 1e300; the axes' arithmetic overflows near the largest f64)")]
+    Undrawable { what: String, value: f64 },
     #[error("panel {panel}, series {series}: scale must be a finite number, found {scale}")]
     BadScale { panel: usize, series: usize, scale: f64 },
     #[error("panel {panel}: nothing to draw: {detail}")]
@@ -185,9 +187,20 @@ pub fn default_label(spec: &SeriesSpec) -> String {
 fn check_range(what: String, r: [f64; 2]) -> Result<(f64, f64), PlotError> {
     let [lo, hi] = r;
     if lo.is_finite() && hi.is_finite() && lo < hi {
-        Ok((lo, hi))
+        drawable(what, (lo, hi))
     } else {
         Err(PlotError::BadRange { what, lo, hi })
+    }
+}
+
+/// The largest magnitude an axis may reach: near f64::MAX the drawing library's tick
+/// arithmetic overflows and loops (a fuzzed CSV with 1e308 hung sc-plot).
+const DRAWABLE: f64 = 1e300;
+
+pub(crate) fn drawable(what: String, (lo, hi): (f64, f64)) -> Result<(f64, f64), PlotError> {
+    match [lo, hi].into_iter().find(|v| v.abs() > DRAWABLE) {
+        Some(value) => Err(PlotError::Undrawable { what, value }),
+        None => Ok((lo, hi)),
     }
 }
 
@@ -246,12 +259,12 @@ pub fn figure(spec: &PlotSpec, base: &Path) -> Result<Figure, PlotError> {
             let place = if spec.x_range.is_some() { " inside x_range" } else { "" };
             return Err(PlotError::NoData { panel, detail: format!("no finite point{place} in {names}") });
         };
-        let y_range = y_fixed.unwrap_or(fitted);
+        let y_range = drawable(format!("panel {panel}: the y axis"), y_fixed.unwrap_or(fitted))?;
         panels.push(Panel { y_label: ps.y_label.clone(), y_range, series });
     }
     let all_x = panels.iter().flat_map(|p| p.series.iter().flat_map(|s| s.points.iter().map(|q| q.0)));
     // every panel has a point (checked above), so the fit exists
-    let x_range = x_range.or_else(|| fit_range(all_x, 0.0)).unwrap_or((0.0, 1.0));
+    let x_range = drawable("the x axis".into(), x_range.or_else(|| fit_range(all_x, 0.0)).unwrap_or((0.0, 1.0)))?;
     Ok(Figure {
         title: spec.title.clone(),
         x_label: spec.x_label.clone().unwrap_or_else(|| spec.x.clone()),
@@ -346,6 +359,12 @@ mod tests {
         assert_eq!(default_label(&series("reaction:top:y")), "a: reaction:top:y");
         let s = SeriesSpec { scale: -1.0, divide_by: Some("reaction:top:y".into()), ..series("reaction:top:x") };
         assert_eq!(default_label(&s), "a: reaction:top:x / reaction:top:y × -1");
+    }
+
+    #[test]
+    fn an_axis_near_the_largest_f64_is_refused() {
+        assert!(matches!(drawable("y".into(), (0.0, 1e308)), Err(PlotError::Undrawable { value, .. }) if value == 1e308));
+        assert_eq!(drawable("y".into(), (-1e200, 1e200)).unwrap(), (-1e200, 1e200));
     }
 
     #[test]
