@@ -28,3 +28,12 @@ pub struct Figure {
     pub x_range: (f64, f64),
     pub panels: Vec<Panel>,
 }
+
+/// The largest magnitude an axis may reach: near f64::MAX the drawing library's tick
+/// arithmetic overflows and loops (a fuzzed CSV with 1e308 hung sc-plot).
+pub const DRAWABLE: f64 = 1e300;
+
+/// The first bound of `r` beyond ±[`DRAWABLE`] (or not a number), if any.
+pub fn undrawable((lo, hi): (f64, f64)) -> Option<f64> {
+    [lo, hi].into_iter().find(|v| !(v.abs() <= DRAWABLE))
+}

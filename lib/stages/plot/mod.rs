@@ -193,14 +193,11 @@ fn check_range(what: String, r: [f64; 2]) -> Result<(f64, f64), PlotError> {
     }
 }
 
-/// The largest magnitude an axis may reach: near f64::MAX the drawing library's tick
-/// arithmetic overflows and loops (a fuzzed CSV with 1e308 hung sc-plot).
-const DRAWABLE: f64 = 1e300;
-
-pub(crate) fn drawable(what: String, (lo, hi): (f64, f64)) -> Result<(f64, f64), PlotError> {
-    match [lo, hi].into_iter().find(|v| v.abs() > DRAWABLE) {
+/// `r` if an axis can span it ([`figure::undrawable`]), else the error naming `what`.
+fn drawable(what: String, r: (f64, f64)) -> Result<(f64, f64), PlotError> {
+    match figure::undrawable(r) {
         Some(value) => Err(PlotError::Undrawable { what, value }),
-        None => Ok((lo, hi)),
+        None => Ok(r),
     }
 }
 

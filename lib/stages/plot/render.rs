@@ -59,7 +59,9 @@ pub fn render_png(fig: &Figure) -> Result<Vec<u8>, String> {
     // the axes' arithmetic overflows and the drawing loops
     let ranges = std::iter::once(("the x axis".to_string(), fig.x_range)).chain(fig.panels.iter().enumerate().map(|(i, p)| (format!("panel {}: the y axis", i + 1), p.y_range)));
     for (what, r) in ranges {
-        super::drawable(what, r).map_err(|e| e.to_string())?;
+        if let Some(value) = super::figure::undrawable(r) {
+            return Err(format!("{what} reaches {value:e}: beyond what can be drawn (|v| ≤ {:e})", super::figure::DRAWABLE));
+        }
     }
     register_embedded_font()?;
     let (w, h) = fig.size;
