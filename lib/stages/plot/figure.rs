@@ -35,5 +35,5 @@ pub const DRAWABLE: f64 = 1e300;
 
 /// The first bound of `r` beyond ±[`DRAWABLE`] (or not a number), if any.
 pub fn undrawable((lo, hi): (f64, f64)) -> Option<f64> {
-    [lo, hi].into_iter().find(|v| !(v.abs() <= DRAWABLE))
+    [lo, hi].into_iter().find(|v| v.is_nan() || v.abs() > DRAWABLE)
 }
