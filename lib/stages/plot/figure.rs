@@ -33,7 +33,24 @@ pub struct Figure {
 /// arithmetic overflows and loops (a fuzzed CSV with 1e308 hung sc-plot).
 pub const DRAWABLE: f64 = 1e300;
 
-/// The first bound of `r` beyond ±[`DRAWABLE`] (or not a number), if any.
-pub fn undrawable((lo, hi): (f64, f64)) -> Option<f64> {
-    [lo, hi].into_iter().find(|v| v.is_nan() || v.abs() > DRAWABLE)
+/// An axis of a figure that cannot be drawn.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{what} reaches {value:e}: beyond what can be drawn (|v| ≤ 1e300; the axes' arithmetic overflows near the largest f64)")]
+pub struct Undrawable {
+    pub what: String,
+    pub value: f64,
+}
+
+impl Figure {
+    /// Every axis within ±[`DRAWABLE`]: the x axis, then each panel's y axis
+    /// (numbered from 1), the first one beyond named.
+    pub fn check_drawable(&self) -> Result<(), Undrawable> {
+        let axes = std::iter::once(("the x axis".to_string(), self.x_range)).chain(self.panels.iter().enumerate().map(|(i, p)| (format!("panel {}: the y axis", i + 1), p.y_range)));
+        for (what, (lo, hi)) in axes {
+            if let Some(value) = [lo, hi].into_iter().find(|v| v.is_nan() || v.abs() > DRAWABLE) {
+                return Err(Undrawable { what, value });
+            }
+        }
+        Ok(())
+    }
 }

@@ -117,8 +117,8 @@ pub enum PlotError {
     BadSize { width: u32, height: u32 },
     #[error("{what} [{lo}, {hi}]: needs finite lo < hi")]
     BadRange { what: String, lo: f64, hi: f64 },
-    #[error("{what} reaches {value:e}: beyond what can be drawn (|v| ≤ 1e300; the axes' arithmetic overflows near the largest f64)")]
-    Undrawable { what: String, value: f64 },
+    #[error(transparent)]
+    Undrawable(#[from] figure::Undrawable),
     #[error("panel {panel}, series {series}: scale must be a finite number, found {scale}")]
     BadScale { panel: usize, series: usize, scale: f64 },
     #[error("panel {panel}: nothing to draw: {detail}")]
@@ -187,17 +187,9 @@ pub fn default_label(spec: &SeriesSpec) -> String {
 fn check_range(what: String, r: [f64; 2]) -> Result<(f64, f64), PlotError> {
     let [lo, hi] = r;
     if lo.is_finite() && hi.is_finite() && lo < hi {
-        drawable(what, (lo, hi))
+        Ok((lo, hi))
     } else {
         Err(PlotError::BadRange { what, lo, hi })
-    }
-}
-
-/// `r` if an axis can span it ([`figure::undrawable`]), else the error naming `what`.
-fn drawable(what: String, r: (f64, f64)) -> Result<(f64, f64), PlotError> {
-    match figure::undrawable(r) {
-        Some(value) => Err(PlotError::Undrawable { what, value }),
-        None => Ok(r),
     }
 }
 
@@ -256,19 +248,21 @@ pub fn figure(spec: &PlotSpec, base: &Path) -> Result<Figure, PlotError> {
             let place = if spec.x_range.is_some() { " inside x_range" } else { "" };
             return Err(PlotError::NoData { panel, detail: format!("no finite point{place} in {names}") });
         };
-        let y_range = drawable(format!("panel {panel}: the y axis"), y_fixed.unwrap_or(fitted))?;
+        let y_range = y_fixed.unwrap_or(fitted);
         panels.push(Panel { y_label: ps.y_label.clone(), y_range, series });
     }
     let all_x = panels.iter().flat_map(|p| p.series.iter().flat_map(|s| s.points.iter().map(|q| q.0)));
     // every panel has a point (checked above), so the fit exists
-    let x_range = drawable("the x axis".into(), x_range.or_else(|| fit_range(all_x, 0.0)).unwrap_or((0.0, 1.0)))?;
-    Ok(Figure {
+    let x_range = x_range.or_else(|| fit_range(all_x, 0.0)).unwrap_or((0.0, 1.0));
+    let figure = Figure {
         title: spec.title.clone(),
         x_label: spec.x_label.clone().unwrap_or_else(|| spec.x.clone()),
         size: (w, h),
         x_range,
         panels,
-    })
+    };
+    figure.check_drawable()?;
+    Ok(figure)
 }
 
 /// Make the plot: read, compute, draw and write the PNG atomically (nothing is
@@ -360,8 +354,11 @@ mod tests {
 
     #[test]
     fn an_axis_near_the_largest_f64_is_refused() {
-        assert!(matches!(drawable("y".into(), (0.0, 1e308)), Err(PlotError::Undrawable { value, .. }) if value == 1e308));
-        assert_eq!(drawable("y".into(), (-1e200, 1e200)).unwrap(), (-1e200, 1e200));
+        let panel = |y_range| Panel { y_label: None, y_range, series: Vec::new() };
+        let fig = Figure { title: None, x_label: "x".into(), size: (320, 240), x_range: (0.0, 1.0), panels: vec![panel((-1e200, 1e200)), panel((0.0, 1e308))] };
+        assert_eq!(fig.check_drawable(), Err(figure::Undrawable { what: "panel 2: the y axis".into(), value: 1e308 }));
+        let fig = Figure { panels: vec![panel((-1e200, 1e200))], ..fig };
+        assert_eq!(fig.check_drawable(), Ok(()));
     }
 
     #[test]

@@ -57,12 +57,7 @@ fn register_embedded_font() -> Result<(), String> {
 pub fn render_png(fig: &Figure) -> Result<Vec<u8>, String> {
     // a figure built by hand (not by `figure`) is checked too: near the largest f64
     // the axes' arithmetic overflows and the drawing loops
-    let ranges = std::iter::once(("the x axis".to_string(), fig.x_range)).chain(fig.panels.iter().enumerate().map(|(i, p)| (format!("panel {}: the y axis", i + 1), p.y_range)));
-    for (what, r) in ranges {
-        if let Some(value) = super::figure::undrawable(r) {
-            return Err(format!("{what} reaches {value:e}: beyond what can be drawn (|v| ≤ {:e})", super::figure::DRAWABLE));
-        }
-    }
+    fig.check_drawable().map_err(|e| e.to_string())?;
     register_embedded_font()?;
     let (w, h) = fig.size;
     let mut rgb = vec![0u8; w as usize * h as usize * 3];
