@@ -162,10 +162,13 @@ impl BSplineProjector {
         self.samples.xi(&self.patch, best.1)
     }
 
+    /// The largest Newton step per direction: `max_step_spans` spans.
+    fn max_step(&self) -> [f64; 2] {
+        self.patch.n_spans().map(|n| self.options.max_step_spans / n as f64)
+    }
+
     fn newton_from(&self, p: &Vec3, xi0: [f64; 2]) -> Projection {
-        let ns = self.patch.n_spans();
-        let o = &self.options;
-        let max_step = [o.max_step_spans / ns[0] as f64, o.max_step_spans / ns[1] as f64];
+        let (o, max_step) = (&self.options, self.max_step());
         let res = newton(
             |xi| self.patch.jet(&self.x, xi),
             p,
@@ -201,9 +204,7 @@ impl BSplineProjector {
     /// would not satisfy the closest-point conditions: on the extension it does, so
     /// the contact residual and its tangent stay consistent.
     pub fn project_extended(&self, p: &Vec3, xi0: [f64; 2], margin: [f64; 2]) -> Projection {
-        let ns = self.patch.n_spans();
-        let o = &self.options;
-        let max_step = [o.max_step_spans / ns[0] as f64, o.max_step_spans / ns[1] as f64];
+        let (o, max_step) = (&self.options, self.max_step());
         let res = newton(|xi| self.patch.jet(&self.x, xi), p, xi0, ([-margin[0], -margin[1]], [1.0 + margin[0], 1.0 + margin[1]]), max_step, o.tol * self.scale, o.max_iterations);
         finish(p, &res, o.outside_tol * self.scale)
     }
@@ -214,9 +215,7 @@ impl BSplineProjector {
     /// either side of a knot line meet at a kink; held on one of them, the residual
     /// and its tangent stay one smooth function.
     pub fn project_in_span(&self, p: &Vec3, xi0: [f64; 2], span: [usize; 2]) -> Projection {
-        let ns = self.patch.n_spans();
-        let o = &self.options;
-        let max_step = [o.max_step_spans / ns[0] as f64, o.max_step_spans / ns[1] as f64];
+        let (o, max_step) = (&self.options, self.max_step());
         let res = newton(|xi| self.patch.jet_in_span(&self.x, xi, span), p, xi0, ([0.0; 2], [1.0; 2]), max_step, o.tol * self.scale, o.max_iterations);
         finish(p, &res, o.outside_tol * self.scale)
     }

@@ -262,7 +262,7 @@ impl PairSolver {
     /// Whether freezing holds anything (facet and atlas masters: their elements and
     /// crease contact; a single patch's spans where it is C⁰; frictional pairs).
     pub fn can_freeze(&self) -> bool {
-        matches!(self.projector, Projector::Facet(_) | Projector::Atlas(_)) || (self.mortar.is_none() && self.projector.has_kinks()) || self.settings.frictional() || self.mortar.is_some()
+        matches!(self.projector, Projector::Facet(_) | Projector::Atlas(_)) || self.projector.has_kinks() || self.settings.frictional() || self.mortar.is_some()
     }
 
     /// The slave has a foot point on the patch: inside, or beyond an edge by less
