@@ -130,29 +130,36 @@ fn refused(mesh: &Mesh, pair: &str, needles: &[&str]) {
 }
 
 #[test]
-fn hole_is_refused() {
-    // 3×3 top faces minus the centre one (hex 4): no grid, pieces of one face each,
-    // and concave corners the subdivision surface does not take. Each reason is given.
+fn hole_gets_a_subdivision_master() {
+    // 3×3 top faces minus the centre one (hex 4): no grid, pieces of one face each, so
+    // one patch is refused with its reason; the hole's four corners are boundary nodes
+    // in 3 faces, which the Catmull–Clark master takes (corner rule), so `bspline`
+    // chooses it and says so.
     let m = block_with_top([3, 3, 1], |e| e != 4);
-    refused(&m, "p:origin:m", &["pair 'p': master face set 'm' has no smooth master", "one grid: face set 'm' has a hole", "2 closed loops", "8 grids (2 × 2, ", "too small for orders [3, 3]", "subdivision: boundary node", "lies in 3 faces"]);
     refused(&m, "p:origin:m:patch", &["pair 'p': master face set 'm' has a hole", "2 closed loops"]);
-    refused(&m, "p:origin:m:subdivision", &["cannot carry a Catmull–Clark surface: boundary node", "lies in 3 faces"]);
-    // facets take any quad set; bilinear B-spline patches fit the one-face pieces
     let dir = tempdir();
     let p = write_mesh(dir.path(), &m);
-    let (o, out) = tag(dir.path(), &p, &["f:origin:m:facet", "b:origin:m:bspline:2:2"]);
+    let (o, out) = tag(dir.path(), &p, &["s:origin:m", "f:origin:m:facet", "b:origin:m:bspline:2:2"]);
     assert!(o.status.success(), "{}", stderr(&o));
     let e = stderr(&o);
+    assert!(e.contains("against master 'm', 8 quads on 16 nodes, subdivision orders [4, 4]"), "{e}");
+    // facets take any quad set; bilinear B-spline patches fit the one-face pieces
     assert!(e.contains("against master 'm', 8 quads on 16 nodes, facet orders [2, 2]") && e.contains("8 grids (2 × 2, 2 × 2, 2 × 2, 2 × 2, 2 × 2, 2 × 2, 2 × 2, 2 × 2), multipatch bspline orders [2, 2]"), "{e}");
-    assert_eq!(ContactModel::read(&out).unwrap().pairs.len(), 2);
+    assert_eq!(ContactModel::read(&out).unwrap().pairs.len(), 3);
 }
 
 #[test]
-fn l_shape_is_refused() {
-    // 2×2 top faces minus hex 3's: the re-entrant corner is named with its faces.
+fn l_shape_is_refused_as_one_patch_and_taken_by_subdivision() {
+    // 2×2 top faces minus hex 3's: one patch names the re-entrant corner with its
+    // faces; `bspline` takes the Catmull–Clark surface, the corner interpolated.
     let m = block_with_top([2, 2, 1], |e| e != 3);
     refused(&m, "p:origin:m:patch", &["non-rectangular outline", "re-entrant corner in 3 faces", "quad 501 (face 1 of hex 1)"]);
-    refused(&m, "p:origin:m", &["has no smooth master", "non-rectangular outline", "re-entrant corner in 3 faces", "subdivision: boundary node 14 (gmsh tag) lies in 3 faces"]);
+    let dir = tempdir();
+    let p = write_mesh(dir.path(), &m);
+    let (o, out) = tag(dir.path(), &p, &["p:origin:m"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("3 quads on 8 nodes, subdivision orders [4, 4]"), "{}", stderr(&o));
+    assert_eq!(ContactModel::read(&out).unwrap().pairs.len(), 1);
 }
 
 #[test]

@@ -42,13 +42,32 @@
 use std::collections::HashMap;
 
 use super::bicubic::{self, Rows, ORDERS};
-use super::stencil::{grid_index, LocalMesh, OpenRing};
+use super::stencil::{grid_index, Boundary, LocalMesh, OpenRing};
 
 /// One Catmull–Clark step of a local mesh (S1–S3). New points whose rule needs a face
 /// outside the local mesh are not created, nor are children that would use them.
 /// Returns the finer mesh and, per parent face and corner, its child face.
 pub(super) fn subdivide(mesh: &LocalMesh) -> (LocalMesh, Vec<[Option<usize>; 4]>) {
+    let (fine, children, _) = subdivide_with(mesh, None);
+    (fine, children)
+}
+
+/// [`subdivide`] with the open boundary's rules where `boundary` marks it
+/// ([`super::boundary_vertex`]):
+/// ```text
+/// boundary edge point     e′ = (v + w)/2                                          (B1)
+/// boundary vertex point   v′ = (l + 6v + r)/8,  or v′ = v at a corner              (B2)
+/// ```
+/// (l, r: v's neighbours along the boundary). A boundary point gets (B2) only when its
+/// fan of faces in the local mesh runs from boundary edge to boundary edge. Returns
+/// the boundary of the finer mesh too: the children of boundary edges, with the edge
+/// points as non-corner boundary points and the vertex points keeping their rule.
+pub(super) fn subdivide_with(
+    mesh: &LocalMesh,
+    boundary: Option<&Boundary>,
+) -> (LocalMesh, Vec<[Option<usize>; 4]>, Boundary) {
     let n_base = mesh.n_base;
+    let mut fine_boundary = Boundary::default();
     let mut points: Vec<Vec<f64>> = Vec::new();
     let combo = |terms: &[(usize, f64)], pts: &[Vec<f64>]| -> Vec<f64> {
         let mut p = vec![0.0; n_base];
@@ -82,6 +101,11 @@ pub(super) fn subdivide(mesh: &LocalMesh) -> (LocalMesh, Vec<[Option<usize>; 4]>
                 }
                 edge_point.insert(key, points.len());
                 points.push(p);
+            } else if boundary.is_some_and(|bd| bd.is_edge(a, b)) {
+                // (B1)
+                fine_boundary.points.insert(points.len(), false);
+                edge_point.insert(key, points.len());
+                points.push(combo(&[(a, 0.5), (b, 0.5)], &mesh.points));
             }
         }
     }
@@ -96,7 +120,21 @@ pub(super) fn subdivide(mesh: &LocalMesh) -> (LocalMesh, Vec<[Option<usize>; 4]>
     let mut corners: Vec<_> = first_corner.into_iter().collect();
     corners.sort_unstable();
     for (v, (f, c)) in corners {
-        let Ok(ring) = mesh.ring(f, c) else { continue };
+        let Ok(ring) = mesh.ring(f, c) else {
+            // (B2) on a boundary point whose fan runs from boundary edge to boundary edge
+            let Some((bd, &corner)) = boundary.and_then(|bd| bd.points.get(&v).map(|c| (bd, c))) else { continue };
+            let (fan, _) = mesh.fan(f, c);
+            let (&(g0, c0), &(g1, c1)) = (fan.first().expect("fan starts non-empty"), fan.last().expect("fan starts non-empty"));
+            let (l, r) = (mesh.faces[g0][(c0 + 1) % 4], mesh.faces[g1][(c1 + 3) % 4]);
+            if !bd.is_edge(v, l) || !bd.is_edge(v, r) {
+                continue;
+            }
+            let p = if corner { mesh.points[v].clone() } else { combo(&[(l, 0.125), (v, 0.75), (r, 0.125)], &mesh.points) };
+            fine_boundary.points.insert(points.len(), corner);
+            vertex_point.insert(v, points.len());
+            points.push(p);
+            continue;
+        };
         let n = ring.len() as f64;
         let mut p: Vec<f64> = mesh.points[v].iter().map(|x| x * (n - 2.0) / n).collect();
         for &(g, cg) in &ring {
@@ -125,7 +163,19 @@ pub(super) fn subdivide(mesh: &LocalMesh) -> (LocalMesh, Vec<[Option<usize>; 4]>
         }
         children.push(ch);
     }
-    (LocalMesh::new(n_base, points, faces), children)
+    // the halves of each boundary edge
+    if let Some(bd) = boundary {
+        for &(a, b) in &bd.edges {
+            if let Some(&e) = edge_point.get(&(a, b)) {
+                for v in [a, b] {
+                    if let Some(&vp) = vertex_point.get(&v) {
+                        fine_boundary.edges.insert((vp.min(e), vp.max(e)));
+                    }
+                }
+            }
+        }
+    }
+    (LocalMesh::new(n_base, points, faces), children, fine_boundary)
 }
 
 /// Stam's subdominant eigenvalue λ(N) of Catmull–Clark at a vertex of valence N.
@@ -245,6 +295,13 @@ impl ValenceTables {
             }
         }
         Ok(Self { m, a, w0, levels, table })
+    }
+
+    /// Tables read off a chain of subdivisions rather than a canonical stencil
+    /// ([`super::boundary_vertex`]): `table` in the layout above over `m` base points,
+    /// `w0` the limit mask of the corner at the origin.
+    pub fn from_chain(m: usize, table: Vec<f64>, w0: Vec<f64>, levels: u32) -> Self {
+        Self { m, a: Vec::new(), table, w0, levels }
     }
 
     /// `A[i][j]`.

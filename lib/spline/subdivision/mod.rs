@@ -45,6 +45,7 @@
 //! Parameters outside `[0,1]²` are clamped to the face.
 
 mod bicubic;
+mod boundary_vertex;
 mod catmull_clark;
 mod control_mesh;
 mod stencil;
@@ -58,7 +59,7 @@ pub use control_mesh::{QuadControlMesh, SubdivisionError};
 
 use bicubic::{row_of, Rows, N_ROWS, N_ROWS_JET, ORDERS};
 use catmull_clark::{subdivide, ValenceTables};
-use stencil::{grid_index, local_mesh, LocalMesh, OpenRing};
+use stencil::{grid_index, local_mesh, GlobalNet, LocalMesh, OpenRing};
 use topology::Topology;
 
 use super::patch::Jet;
@@ -76,6 +77,9 @@ pub enum FaceKind {
     Extraordinary { valence: usize },
     /// Several extraordinary corners: split once into four quarters.
     Split,
+    /// A corner is a boundary node in three or more faces: chain tables there, in one
+    /// piece or (with more irregular corners) in four quarters.
+    BoundaryCorner { pieces: usize },
 }
 
 /// One parameter region of a face with its own stencil.
@@ -90,6 +94,9 @@ struct Piece {
     chain: [[f64; N_ROWS]; N_ROWS],
     /// `None`: regular bicubic piece (stencil rows in grid order); `Some(N)`: `2N+8` stencil.
     valence: Option<usize>,
+    /// `Some(i)`: evaluated by [`CatmullClark::corner_tables`]`[i]` over the whole
+    /// support (a boundary node in three or more faces at the origin).
+    tables: Option<usize>,
     /// First stencil row in [`CatmullClark::row_ptr`].
     first_row: usize,
 }
@@ -116,6 +123,8 @@ pub struct CatmullClark {
     entries: Vec<(u8, f64)>,
     /// Tables per valence (index N), built for the valences present.
     valences: Vec<Option<ValenceTables>>,
+    /// Chain tables of the pieces at boundary nodes in three or more faces, one per piece.
+    corner_tables: Vec<ValenceTables>,
 }
 
 /// Parameter positions of a face's corners.
@@ -129,9 +138,6 @@ impl CatmullClark {
             let (node, n) = (v as u32, ring.faces.len());
             if n == 0 {
                 continue;
-            }
-            if ring.boundary && n > 2 {
-                return Err(SubdivisionError::UnsupportedBoundaryNode { node, faces: n });
             }
             if !ring.boundary && n < 3 {
                 return Err(SubdivisionError::ValenceTooLow { node, valence: n });
@@ -148,9 +154,14 @@ impl CatmullClark {
             row_ptr: vec![0],
             entries: Vec::new(),
             valences: vec![None; MAX_VALENCE + 1],
+            corner_tables: Vec::new(),
         };
         for f in 0..mesh.faces.len() {
-            let (local, support) = local_mesh(mesh, &topo, f)?;
+            if boundary_vertex::touches_irregular_boundary(mesh, &topo, f) {
+                cc.push_boundary_corner_face(mesh, &topo, f)?;
+                continue;
+            }
+            let (local, support) = local_mesh(&GlobalNet { mesh, topo: &topo }, f)?;
             if support.len() > MAX_NODES {
                 return Err(SubdivisionError::SupportTooLarge { face: f, nodes: support.len(), max: MAX_NODES });
             }
@@ -176,14 +187,7 @@ impl CatmullClark {
                     let (fine, children) = subdivide(&local);
                     for (c, child) in children[0].iter().enumerate() {
                         let child = child.ok_or(SubdivisionError::StencilIncomplete { face: f })?;
-                        let mid = |a: [f64; 2], b: [f64; 2]| [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0];
-                        let pos = [
-                            CORNERS[c],
-                            mid(CORNERS[c], CORNERS[(c + 1) % 4]),
-                            [0.5, 0.5],
-                            mid(CORNERS[(c + 3) % 4], CORNERS[c]),
-                        ];
-                        cc.push_piece(&fine, child, 0, pos).map_err(incomplete)?;
+                        cc.push_piece(&fine, child, 0, quarter(c)).map_err(incomplete)?;
                     }
                     FaceKind::Split
                 }
@@ -202,16 +206,80 @@ impl CatmullClark {
         Ok(cc)
     }
 
+    /// Adds face `f`, one of whose corners is a boundary node in three or more faces
+    /// ([`boundary_vertex`]): with that one irregular corner, its tables; with more,
+    /// one subdivision step (with the boundary rules) and a piece per quarter.
+    fn push_boundary_corner_face(&mut self, mesh: &QuadControlMesh, topo: &Topology, f: usize) -> Result<(), SubdivisionError> {
+        let incomplete = boundary_vertex::incomplete(f);
+        let (real, bd, support) = boundary_vertex::real_local_mesh(mesh, topo, f);
+        if support.len() > MAX_NODES {
+            return Err(SubdivisionError::SupportTooLarge { face: f, nodes: support.len(), max: MAX_NODES });
+        }
+        let q = mesh.faces[f];
+        let irregular = |v: u32| {
+            let ring = &topo.rings[v as usize];
+            if ring.boundary { ring.faces.len() > 2 } else { ring.faces.len() != 4 }
+        };
+        let s0 = self.support.len();
+        self.support.extend(&support);
+        let p0 = self.pieces.len();
+        let ev: Vec<usize> = (0..4).filter(|&c| irregular(q[c])).collect();
+        if let &[r] = ev.as_slice() {
+            let tables = boundary_vertex::corner_tables(&real, &bd, 0, r).map_err(&incomplete)?;
+            self.push_table_piece(tables, r, CORNERS);
+        } else {
+            let (fine, children, fine_bd) = catmull_clark::subdivide_with(&real, Some(&bd));
+            for (c, child) in children[0].iter().enumerate() {
+                let child = child.ok_or(SubdivisionError::StencilIncomplete { face: f })?;
+                let pos = quarter(c);
+                if boundary_vertex::is_irregular_boundary(topo, q[c]) {
+                    let tables = boundary_vertex::corner_tables(&fine, &fine_bd, child, 0).map_err(&incomplete)?;
+                    self.push_table_piece(tables, 0, pos);
+                } else {
+                    let lm = boundary_vertex::stencil_rows(&fine, child).map_err(&incomplete)?;
+                    self.push_piece(&lm, 0, 0, pos).map_err(&incomplete)?;
+                }
+            }
+        }
+        for p in &self.pieces[p0..] {
+            if let Some(n) = p.valence {
+                if self.valences[n].is_none() {
+                    self.valences[n] = Some(ValenceTables::new(n).expect("the canonical stencil mesh is complete"));
+                }
+            }
+        }
+        let across = [0, 1, 2, 3].map(|c| topo.half_edge(q[(c + 1) % 4], q[c]));
+        let kind = FaceKind::BoundaryCorner { pieces: self.pieces.len() - p0 };
+        self.faces.push(FaceData { support: (s0, support.len()), pieces: (p0, self.pieces.len() - p0), kind, across });
+        Ok(())
+    }
+
+    /// Adds a piece evaluated by chain tables over the face's whole support (identity
+    /// stencil rows), origin at corner `r` of the parameter square `pos`.
+    fn push_table_piece(&mut self, tables: ValenceTables, r: usize, pos: [[f64; 2]; 4]) {
+        let (origin, jac) = frame(pos, r);
+        let first_row = self.row_ptr.len() - 1;
+        for k in 0..tables.m {
+            self.entries.push((k as u8, 1.0));
+            self.row_ptr.push(self.entries.len() as u32);
+        }
+        self.corner_tables.push(tables);
+        self.pieces.push(Piece {
+            origin,
+            jac,
+            chain: chain_rule(&jac),
+            valence: None,
+            tables: Some(self.corner_tables.len() - 1),
+            first_row,
+        });
+    }
+
     /// Adds the piece of local face `g` with its origin at corner `r` (the
     /// extraordinary corner, if any); `pos` are the face parameters of `g`'s corners.
     fn push_piece(&mut self, lm: &LocalMesh, g: usize, r: usize, pos: [[f64; 2]; 4]) -> Result<(), OpenRing> {
         let n = lm.valence(g, r)?;
         let st = lm.stencil(g, r)?;
-        let origin = pos[r];
-        let axis = |k: usize| [pos[k][0] - origin[0], pos[k][1] - origin[1]];
-        let (es, et) = (axis((r + 1) % 4), axis((r + 3) % 4));
-        let h2 = es[0] * es[0] + es[1] * es[1];
-        let jac = [[es[0] / h2, es[1] / h2], [et[0] / h2, et[1] / h2]];
+        let (origin, jac) = frame(pos, r);
         let first_row = self.row_ptr.len() - 1;
         let mut rows: Vec<&[f64]> = vec![&[]; st.len()];
         for (k, &p) in st.iter().enumerate() {
@@ -226,7 +294,7 @@ impl CatmullClark {
             }
             self.row_ptr.push(self.entries.len() as u32);
         }
-        self.pieces.push(Piece { origin, jac, chain: chain_rule(&jac), valence: (n != 4).then_some(n), first_row });
+        self.pieces.push(Piece { origin, jac, chain: chain_rule(&jac), valence: (n != 4).then_some(n), tables: None, first_row });
         Ok(())
     }
 
@@ -276,12 +344,17 @@ impl CatmullClark {
         let d = [u - p.origin[0], v - p.origin[1]];
         let st = [0, 1].map(|a| (p.jac[a][0] * d[0] + p.jac[a][1] * d[1]).clamp(0.0, 1.0));
         let mut local: Rows = [[0.0; MAX_NODES]; N_ROWS];
-        let m = match p.valence {
-            None => {
+        let m = match (p.tables, p.valence) {
+            (Some(i), _) => {
+                let tables = &self.corner_tables[i];
+                tables.weights_into(st, n_rows, &mut local);
+                tables.m
+            }
+            (None, None) => {
                 bicubic::weights_into(st, n_rows, &mut local);
                 16
             }
-            Some(n) => {
+            (None, Some(n)) => {
                 let tables = self.valences[n].as_ref().expect("tables built in new");
                 tables.weights_into(st, n_rows, &mut local);
                 tables.m
@@ -391,6 +464,23 @@ impl CatmullClark {
     }
 }
 
+
+/// The face parameters of the corners of the quarter at corner `c` of a face (its
+/// corner 0 at the face's corner c, as [`subdivide`] orders a child).
+fn quarter(c: usize) -> [[f64; 2]; 4] {
+    let mid = |a: [f64; 2], b: [f64; 2]| [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0];
+    [CORNERS[c], mid(CORNERS[c], CORNERS[(c + 1) % 4]), [0.5, 0.5], mid(CORNERS[(c + 3) % 4], CORNERS[c])]
+}
+
+/// The origin and `jac[a][α] = ∂s_a/∂u_α` of a piece whose corners sit at the face
+/// parameters `pos`, its `s` along corner r → r+1 and `t` along r → r−1.
+fn frame(pos: [[f64; 2]; 4], r: usize) -> ([f64; 2], [[f64; 2]; 2]) {
+    let origin = pos[r];
+    let axis = |k: usize| [pos[k][0] - origin[0], pos[k][1] - origin[1]];
+    let (es, et) = (axis((r + 1) % 4), axis((r + 3) % 4));
+    let h2 = es[0] * es[0] + es[1] * es[1];
+    (origin, [[es[0] / h2, es[1] / h2], [et[0] / h2, et[1] / h2]])
+}
 
 /// The chain rule of the derivative rows for a piece whose local `(s, t)` follow
 /// from the face's `(u, v)` by `jac[a][α] = ∂s_a/∂u_α`: `∂_α = Σ_a jac[a][α] ∂_a`,

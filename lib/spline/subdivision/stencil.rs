@@ -26,7 +26,7 @@
 
 use std::collections::HashMap;
 
-use super::topology::Topology;
+use super::topology::{Ring, Topology};
 use super::control_mesh::{QuadControlMesh, SubdivisionError};
 
 /// Grid position `(i, j)` (−1…2 each, the regular patch over `[0,1]²`) of the 16
@@ -73,6 +73,24 @@ pub(super) struct LocalMesh {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(super) struct OpenRing;
 
+/// Which points and edges of a local mesh lie on the surface's open boundary (the
+/// true boundary, not where the local mesh is cut off), and the rule of each boundary
+/// point: a *corner* stays where it is (v′ = v), any other boundary point follows the
+/// cubic B-spline curve of the boundary, v′ = (l + 6v + r)/8.
+#[derive(Debug, Clone, Default)]
+pub(super) struct Boundary {
+    /// Boundary point → whether it is a corner.
+    pub points: HashMap<usize, bool>,
+    /// Boundary edges, as (smaller, larger) point index.
+    pub edges: std::collections::HashSet<(usize, usize)>,
+}
+
+impl Boundary {
+    pub fn is_edge(&self, a: usize, b: usize) -> bool {
+        self.edges.contains(&(a.min(b), a.max(b)))
+    }
+}
+
 impl LocalMesh {
     pub fn new(n_base: usize, points: Vec<Vec<f64>>, faces: Vec<[usize; 4]>) -> Self {
         let mut half_edges = HashMap::with_capacity(4 * faces.len());
@@ -106,6 +124,34 @@ impl LocalMesh {
             }
             ring.push(next);
         }
+    }
+
+    /// The faces around corner `corner` of `face` in ring order (the order of
+    /// [`Topology`]: a boundary fan runs from the face whose edge `v → F[c+1]` has no
+    /// twin to the face whose edge `F[c+3] → v` has none), and whether the ring closes.
+    pub fn fan(&self, face: usize, corner: usize) -> (Vec<(usize, usize)>, bool) {
+        if let Ok(ring) = self.ring(face, corner) {
+            return (ring, true);
+        }
+        let v = self.faces[face][corner];
+        // back to the first face: the previous face holds F[c+1] → v
+        let mut start = (face, corner);
+        for _ in 0..self.faces.len() {
+            let (f, c) = start;
+            match self.half_edge(self.faces[f][(c + 1) % 4], v) {
+                Some((g, cb)) => start = (g, (cb + 1) % 4),
+                None => break,
+            }
+        }
+        let mut fan = vec![start];
+        while fan.len() <= self.faces.len() {
+            let (f, c) = *fan.last().expect("fan starts non-empty");
+            match self.half_edge(v, self.faces[f][(c + 3) % 4]) {
+                Some(next) => fan.push(next),
+                None => break,
+            }
+        }
+        (fan, false)
     }
 
     /// Valence of corner `corner` of `face` (its number of faces).
@@ -146,6 +192,36 @@ impl LocalMesh {
     }
 }
 
+/// A quad net the local mesh is read from: the global control mesh, or a subdivided
+/// local mesh near a boundary node in three or more faces ([`super::boundary_vertex`]).
+/// Only the rings of the asked face's corners are read, and those must be complete.
+pub(super) trait Net {
+    /// The node cycle of face `g`.
+    fn quad(&self, g: usize) -> [u32; 4];
+    /// The faces around node `v` in ring order (see [`Topology`]).
+    fn ring(&self, v: u32) -> std::borrow::Cow<'_, Ring>;
+    /// Whether some face holds the directed edge `a → b`.
+    fn has_edge(&self, a: u32, b: u32) -> bool;
+}
+
+/// The global control mesh with its topology.
+pub(super) struct GlobalNet<'a> {
+    pub mesh: &'a QuadControlMesh,
+    pub topo: &'a Topology,
+}
+
+impl Net for GlobalNet<'_> {
+    fn quad(&self, g: usize) -> [u32; 4] {
+        self.mesh.faces[g]
+    }
+    fn ring(&self, v: u32) -> std::borrow::Cow<'_, Ring> {
+        std::borrow::Cow::Borrowed(&self.topo.rings[v as usize])
+    }
+    fn has_edge(&self, a: u32, b: u32) -> bool {
+        self.topo.half_edge(a, b).is_some()
+    }
+}
+
 /// What a point of a face's local mesh is, before it becomes a combination of nodes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 enum PointKey {
@@ -159,11 +235,7 @@ enum PointKey {
 /// The local mesh of real face `face`: every real face around its four corners plus
 /// the phantom faces around its boundary corners. Its base points are the face's
 /// *support* (the real nodes it depends on), returned in order of first appearance.
-pub(super) fn local_mesh(
-    mesh: &QuadControlMesh,
-    topo: &Topology,
-    face: usize,
-) -> Result<(LocalMesh, Vec<u32>), SubdivisionError> {
+pub(super) fn local_mesh<N: Net>(net: &N, face: usize) -> Result<(LocalMesh, Vec<u32>), SubdivisionError> {
     let mut keys: Vec<PointKey> = Vec::new();
     let mut index: HashMap<PointKey, usize> = HashMap::new();
     let mut faces: Vec<[usize; 4]> = Vec::new();
@@ -186,26 +258,27 @@ pub(super) fn local_mesh(
         }
     };
     // the real face first, so it is face 0 of the local mesh
-    let quad = mesh.faces[face];
+    let quad = net.quad(face);
     add_face(quad.map(PointKey::Node), &mut keys, &mut faces);
     for &v in &quad {
-        let ring = &topo.rings[v as usize];
+        let ring = net.ring(v);
+        let ring = ring.as_ref();
         if ring.boundary && ring.faces.len() > 2 {
             return Err(SubdivisionError::UnsupportedBoundaryNode { node: v, faces: ring.faces.len() });
         }
         for &(g, _) in &ring.faces {
-            add_face(mesh.faces[g].map(PointKey::Node), &mut keys, &mut faces);
+            add_face(net.quad(g).map(PointKey::Node), &mut keys, &mut faces);
         }
         if !ring.boundary {
             continue;
         }
         for &(g, c) in &ring.faces {
-            let q = mesh.faces[g];
+            let q = net.quad(g);
             let at = |k: usize| q[(c + k) % 4];
             // boundary edges of g at v: v → q[c+1] and q[c+3] → v
             for (a_corner, is_boundary) in [
-                (c, topo.half_edge(at(1), v).is_none()),
-                ((c + 3) % 4, topo.half_edge(v, at(3)).is_none()),
+                (c, !net.has_edge(at(1), v)),
+                ((c + 3) % 4, !net.has_edge(v, at(3))),
             ] {
                 if !is_boundary {
                     continue;
