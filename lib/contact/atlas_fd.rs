@@ -1,7 +1,8 @@
 //! The contact element's tangent against finite differences on every master of many
 //! charts: a periodic B-spline at its seam, a multi-patch B-spline next to a seam,
 //! the Catmull–Clark limit surface on regular faces, next to extraordinary nodes of
-//! valence 3, 5 and 6 and on boundary faces, and facets on a free quad set.
+//! valence 3, 5 and 6, on boundary faces and next to concave corners, and facets on
+//! a free quad set.
 //! Frictionless, stick and slip. The slave is re-projected on the same chart at
 //! every perturbation (the element's chart is held within a Newton iterate).
 
@@ -169,6 +170,43 @@ fn subdivision_regular_extraordinary_and_boundary_faces() {
             check("subdivision regular face", atlas, &x, 4, [0.45, 0.55]);
         }
     }
+}
+
+/// An L (a 4 × 4 grid of faces without its 2 × 2 corner block) and a plus (the 3 × 3
+/// block without its corner faces), lifted: the Catmull–Clark master next to a
+/// concave corner (a boundary node in 3 faces, the corner rule), and on the plus's
+/// centre face, whose four corners are such nodes (split in quarters).
+#[test]
+fn subdivision_next_to_concave_corners() {
+    let lifted = |i: usize, j: usize| {
+        let (a, b) = (i as f64, j as f64);
+        Vec3::new(a + 0.05 * b, b, 0.2 * (0.7 * a).sin() + 0.15 * (0.9 * b + 0.3).cos())
+    };
+    let grid = |n: usize, keep: &dyn Fn(usize, usize) -> bool| {
+        let x: Vec<Vec3> = (0..n * n).map(|k| lifted(k % n, k / n)).collect();
+        let id = |i: usize, j: usize| (i + n * j) as u32;
+        let mut faces = Vec::new();
+        for j in 0..n - 1 {
+            for i in 0..n - 1 {
+                if keep(i, j) {
+                    faces.push([id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
+                }
+            }
+        }
+        (x, faces)
+    };
+    let (x, faces) = grid(5, &|i, j| i < 2 || j < 2);
+    let atlas = Atlas::subdivision(x.len(), faces.clone()).unwrap();
+    // face (1, 1) is face 5 and has the concave node (2, 2) at its corner 2
+    assert_eq!(faces[5][2], 12);
+    check("subdivision next to a concave corner", atlas.clone(), &x, 5, [0.93, 0.96]);
+    check("subdivision on a face along the corner's edge", atlas, &x, 6, [0.1, 0.8]);
+    let (x, faces) = grid(4, &|i, j| i == 1 || j == 1);
+    let atlas = Atlas::subdivision(x.len(), faces.clone()).unwrap();
+    // the centre face (1, 1) is face 2 of the plus
+    assert_eq!(faces[2], [5, 6, 10, 9]);
+    check("subdivision, plus centre quarter", atlas.clone(), &x, 2, [0.3, 0.45]);
+    check("subdivision, plus centre near a corner", atlas, &x, 2, [0.97, 0.95]);
 }
 
 #[test]
