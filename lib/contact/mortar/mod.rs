@@ -246,7 +246,9 @@ impl Mortar {
     /// its corners: a cell whose image cuts the face passes the walk on to the cells
     /// that share a node with it (the cells under the corners always do, as a corner
     /// on a cell edge may face the neighbouring cell). The cells that cut a convex
-    /// face are connected, so none is missed, on any quad net.
+    /// face are connected, so none is missed, on any quad net. A face's points are
+    /// kept in cell order, not in the walk's, so the sums over them do not depend
+    /// on the cells the last search left the corners in (a restart has none).
     pub fn integrate(&mut self, geometry: &Projector, x_net: &[Vec3], x_slave: &[Vec3], feet: Feet<'_>, areas: &[f64]) -> Result<(), SplineError> {
         self.trace.update(x_net)?;
         let trace = &self.trace;
@@ -328,6 +330,15 @@ impl Mortar {
                             }
                         }
                     }
+                    // The walk starts from the cells under the corners, which a corner
+                    // on a cell edge keeps from the last search (`Trace::locate`), so
+                    // it meets the cells in an order the search's history sets. In
+                    // cell order (each cell's points in its quadrature's order) the
+                    // sums over the points (ĝ_s, the residual, the tangent) are the
+                    // same function of the configuration whatever that history: a run
+                    // restarted from its results file, whose first search starts
+                    // afresh, repeats the uninterrupted run bit for bit.
+                    pts.sort_by_key(|p| p.cell);
                     skipped
                 },
             )
@@ -531,4 +542,51 @@ fn project_point(geometry: &Projector, trace: &Trace, x: &Vec3, cell: usize, sta
     };
     let t = trace.project_on_cell(x, cell)?;
     Some(Foot { xi: p.xi, element, zeta: t.xi, g: p.g })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contact::NetShape;
+    use crate::format::sccontact::MasterKind;
+
+    /// Slave corners on the master's cell edges are located in either cell, the one
+    /// the last search left (`Trace::locate` keeps it at ties), so the walk over the
+    /// cells starts elsewhere after a restart than in the uninterrupted run. The
+    /// quadrature points, and the weighted gaps summed over them, come out the same
+    /// bit for bit whichever cells the corners start from.
+    #[test]
+    fn the_integration_does_not_depend_on_the_cells_the_last_search_left() {
+        // a 5 × 5 facet net, z = 0, unit cells; a 3 × 3 slave patch whose rows lie
+        // on the net's lines y = 1, 2, 3, pressed in by different depths
+        let (a, b) = (5, 5);
+        let x_net: Vec<Vec3> = (0..a * b).map(|k| Vec3::new((k % a) as f64, (k / a) as f64, 0.0)).collect();
+        let net = MasterNet { nodes: (0..(a * b) as u32).collect(), shape: NetShape::Grid { a, b } };
+        let x_slave: Vec<Vec3> = (0..9).map(|k| Vec3::new(1.5 + (k % 3) as f64, 1.0 + (k / 3) as f64, -0.01 - 0.003 * k as f64)).collect();
+        let mut x_all = x_net.clone();
+        x_all.extend(&x_slave);
+        let slaves: Vec<u32> = (0..9).map(|s| (a * b) as u32 + s).collect();
+        let faces: Vec<[u32; 4]> = [[0, 1, 4, 3], [1, 2, 5, 4], [3, 4, 7, 6], [4, 5, 8, 7]].iter().map(|f: &[u32; 4]| f.map(|s| slaves[s as usize])).collect();
+        let geometry = Projector::for_net(MasterKind::Facet, [2, 2], &net, &x_net).unwrap();
+        let feet: Vec<_> = x_slave.iter().map(|x| geometry.project(x, None)).collect();
+        let points: Vec<_> = feet.iter().map(|(p, c)| geometry.evaluate(p.xi, *c)).collect();
+        let (projections, elements): (Vec<_>, Vec<_>) = feet.into_iter().unzip();
+        let feet = Feet { projections: &projections, elements: &elements, points: &points };
+        let areas = vec![1.0; 9];
+        let mut fresh = Mortar::new(&faces, &slaves, &x_all, &net, Multipliers::Standard, Transfer::Trace, f64::INFINITY).unwrap().unwrap();
+        let mut kept = fresh.clone();
+        fresh.integrate(&geometry, &x_net, &x_slave, feet, &areas).unwrap();
+        // every corner starts from the other cell of its edge (cells a − 1 wide)
+        let cells_a = a - 1;
+        kept.node_cell = fresh.node_cell.iter().zip(&x_slave).map(|(c, x)| c.map(|c| if c / cells_a == x.y as usize { c - cells_a } else { c + cells_a })).collect();
+        let seeds = kept.node_cell.clone();
+        kept.integrate(&geometry, &x_net, &x_slave, feet, &areas).unwrap();
+        assert_eq!(kept.node_cell, seeds, "the ties keep the cells given");
+        assert_ne!(kept.node_cell, fresh.node_cell);
+        for f in 0..faces.len() as u32 {
+            assert!(fresh.points(f).len() >= 2 * 14, "face {f}: {} points", fresh.points(f).len());
+            assert_eq!(fresh.points(f), kept.points(f), "face {f}");
+        }
+        assert_eq!(fresh.gap.iter().map(|g| g.to_bits()).collect::<Vec<_>>(), kept.gap.iter().map(|g| g.to_bits()).collect::<Vec<_>>());
+    }
 }
