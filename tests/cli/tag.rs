@@ -162,6 +162,45 @@ fn l_shape_is_refused_as_one_patch_and_taken_by_subdivision() {
     assert_eq!(ContactModel::read(&out).unwrap().pairs.len(), 1);
 }
 
+/// The box of issue 26, meshed by gmsh with all hexahedra but unstructured
+/// (`tests/data/gmsh/allhex_box.geo`): its top has boundary nodes in 1 and 3 faces.
+/// One patch is refused, naming such a node; `bspline` takes the Catmull–Clark
+/// surface, which is the flat top: every face evaluated on a 5 × 5 grid of
+/// parameters lies on z = 0.3 inside the unit square.
+#[test]
+fn an_unstructured_gmsh_box_top_gets_a_subdivision_master() {
+    let dir = tempdir();
+    let mesh = dir.path().join("m.scmesh");
+    let msh = repo().join("tests/data/gmsh/allhex_box.msh");
+    let o = run("sc-import", &[msh.to_str().unwrap(), "-o", mesh.to_str().unwrap(), "--quiet"], dir.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (o, _) = tag(dir.path(), &mesh, &["p:bottom:top:patch"]);
+    assert!(!o.status.success() && stderr(&o).contains("is a re-entrant corner in 3 faces"), "{}", stderr(&o));
+    let (o, out) = tag(dir.path(), &mesh, &["c:bottom:top"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("against master 'top', 42 quads on 51 nodes, subdivision orders [4, 4]"), "{}", stderr(&o));
+    let m = ContactModel::read(&out).unwrap();
+    let p = &m.pairs[0];
+    assert_eq!(p.master_kind, MasterKind::Subdivision);
+    let cells = p.net.cells();
+    let atlas = splinecontact::spline::Atlas::subdivision(p.net.nodes.len(), cells.clone()).unwrap();
+    let x: Vec<Vec3> = p.net.nodes.iter().map(|&n| Vec3::from(m.mesh.nodes[n as usize])).collect();
+    let mut atlas = atlas;
+    atlas.update(&x).unwrap();
+    let mut worst = 0.0f64;
+    for chart in 0..cells.len() {
+        for i in 0..5 {
+            for j in 0..5 {
+                let sp = atlas.evaluate(chart, [i as f64 / 4.0, j as f64 / 4.0]);
+                worst = worst.max((sp.x_bar.z - 0.3).abs());
+                assert!((-1e-12..=1.0 + 1e-12).contains(&sp.x_bar.x) && (-1e-12..=1.0 + 1e-12).contains(&sp.x_bar.y), "chart {chart}: {:?}", sp.x_bar);
+                assert!(sp.n_bar.z > 1.0 - 1e-12, "chart {chart}: n̄ = {:?}", sp.n_bar);
+            }
+        }
+    }
+    assert!(worst < 1e-14, "the flat top is not flat: {worst:e}");
+}
+
 #[test]
 fn faces_meeting_at_a_point_are_refused() {
     let m = block_with_top([2, 2, 1], |e| e == 0 || e == 3);
