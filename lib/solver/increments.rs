@@ -345,6 +345,7 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
                     ));
                     lambda_prev = lambda;
                     failures = 0;
+                    newton.early_segmentation_hold = false;
                     if lambda >= target {
                         break;
                     }
@@ -353,6 +354,13 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
                 Err(failure) => {
                     for pair in &mut newton.contact {
                         pair.restore();
+                    }
+                    // mortar: first the same step again, the segmentation held early
+                    // (`Newton::early_segmentation_hold`); then the cutbacks, still so
+                    if !newton.early_segmentation_hold && newton.contact.iter().any(|c| c.mortar_skipped_cells().is_some()) {
+                        newton.early_segmentation_hold = true;
+                        log.line(&format!("increment {}/{n_inc} at load factor {lambda:.6}: {failure}; solving it again with the mortar segmentation held from a relative residual of 1e-1", k + 1));
+                        continue;
                     }
                     failures += 1;
                     if failures > max_cutbacks {

@@ -122,18 +122,13 @@ fn paper_examples_under_mortar_are_pinned() {
     // (pipeline, node-to-surface max |u|, mortar max |u|, its node tags, mortar Newton corrections)
     let pins: [(&str, f64, f64, &[u64], usize); 3] = [
         ("crossed_beams", 1.11427638, 1.23245042, &[15], 22),
-        ("parallel_beams", 0.33898814, 0.33775584, &[86, 87, 90, 91], 194),
+        ("parallel_beams", 0.33898814, 0.33764117, &[86, 87, 90, 91], 164),
         ("supported_beam", 0.79809336, 0.82502866, &[15], 118),
     ];
     for (name, u_node, u_pin, tag_pin, its_pin) in pins {
         let mortar = |yaml: &str| {
-            let mut mortar = yaml.replace("enforcement: augmented_lagrangian,", "enforcement: augmented_lagrangian, integration: mortar,");
+            let mortar = yaml.replace("enforcement: augmented_lagrangian,", "enforcement: augmented_lagrangian, integration: mortar,");
             assert!(mortar.contains("integration: mortar"), "{name}: no contact entry to change");
-            if name == "parallel_beams" {
-                // the paper's 30 increments stall under mortar near λ = 0.48 (docs/validation.md)
-                mortar = mortar.replace("increments: {count: 30, max_cutbacks: 5}", "increments: {count: 60, max_cutbacks: 5}\n        linear_solver: lu");
-                assert!(mortar.contains("count: 60"), "{name}: no increments entry to change");
-            }
             mortar
         };
         let (r, _) = run_edited(name, mortar);
@@ -156,7 +151,9 @@ fn paper_examples_under_mortar_are_pinned() {
 /// after 8 cutbacks. Pinned: it completes (with 7 cutbacks late in the load), and
 /// its max |u| lies within 1 % of node-to-surface's on the same frictionless setup
 /// (measured: 0.33579959 against 0.33743991, −0.49 %; the frictional pin above
-/// measures −0.36 %).
+/// measures −0.40 %). The increments that fail late in the load are solved again
+/// with the segmentation held early before they are cut back; their Newton does
+/// not get below 1e-1 there, so the cutbacks do the work.
 #[test]
 fn frictionless_parallel_beams_under_mortar_cross_the_master_edge() {
     let frictionless = |yaml: &str, mortar: bool| {

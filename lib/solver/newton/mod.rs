@@ -126,6 +126,10 @@ pub struct Newton<'p> {
     /// The length the schedule planned for the increment being solved (the
     /// stabilisation stiffens when a cutback shortens it).
     pub planned_step: Option<f64>,
+    /// Mortar pairs hold their segmentation from a relative residual of 1e-1
+    /// instead of 1e-5 (`iteration::MORTAR_EARLY_HOLD_RESIDUAL`): set by the
+    /// increment loop for an increment that failed without it, until it converges.
+    pub early_segmentation_hold: bool,
     /// A full-length Newton correction (storage reused by the step limit).
     du_full: Vec<f64>,
     /// Inexact Newton: an iterative linear solver's tolerance follows the residual
@@ -239,6 +243,7 @@ impl<'p> Newton<'p> {
             frozen_at: None,
             notes: Vec::new(),
             planned_step: None,
+            early_segmentation_hold: false,
             du_full: vec![0.0; n],
             forcing,
         })
