@@ -154,12 +154,15 @@ fn patch_test_mortar_is_exact_on_several_patches() {
                 // the one case that is not exact: 2.401e-7, at the slave nodes near the
                 // arms' ends, symmetric about the L's diagonal. The surface is the flat L
                 // to 1e-15 and every quadrature point's gap is its height above it to
-                // round-off, but the converged master is not flat: its top varies by
-                // 2.3e-12 near the arms' ends (2.4e-12 / 1e-5 of gap = 2.4e-7 of
-                // pressure), the same with the Newton tolerance at 1e-13. Dual
-                // multipliers on the same mesh are exact (2.5e-10). So the master's
-                // nodal forces are not quite those of a uniform traction there; the
-                // source is not located. Pinned at the measured value + 20 %.
+                // round-off; but the slave faces at the arms' ends reach past the master
+                // cells' images by a sliver (face [5/6, 1] × [2/6, ½] is covered to
+                // 2.0e-9 of its area short, 854 points in all, 5.6e-9 of the area
+                // missing), which the segments leave out. The segmentation is held from
+                // an iterate where the two outlines still differ (relative residual
+                // 1e-5), and the state converged with it keeps the sliver: a second
+                // solution of the held problem, next to the exact one in which the
+                // outlines coincide (the B-spline and facet masters reach that one).
+                // Pinned at the measured value + 20 %.
                 eprintln!("  {what}: pointwise {:.3e} (pinned 2.401e-7 + 20 %), total {:.3e}, equilibrium {:.3e}", p.pointwise, p.total, p.equilibrium);
                 assert!(p.pointwise < 1.2 * 2.401e-7 && p.total < TOL && p.equilibrium < TOL, "{what}: pointwise {:e}", p.pointwise);
                 continue;
