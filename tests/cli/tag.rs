@@ -201,6 +201,44 @@ fn an_unstructured_gmsh_box_top_gets_a_subdivision_master() {
     assert!(worst < 1e-14, "the flat top is not flat: {worst:e}");
 }
 
+/// A fan of 15 hexahedra around a vertical edge: the top's centre node has valence
+/// 15, above the 14 a Catmull–Clark stencil of 36 nodes holds. No smooth master fits
+/// (one grid, 15 one-cell grids too small for orders [3, 3], subdivision), and each
+/// reason is given; facets take it.
+#[test]
+fn a_node_of_valence_15_has_no_smooth_master() {
+    let n = 15;
+    let mut nodes = Vec::new();
+    for z in [0.0, 1.0] {
+        nodes.push(Vec3::new(0.0, 0.0, z));
+        for i in 0..n {
+            let th = std::f64::consts::TAU * i as f64 / n as f64;
+            let th2 = std::f64::consts::TAU * (i as f64 + 0.5) / n as f64;
+            nodes.push(Vec3::new(th.cos(), th.sin(), z)); // e_i
+            nodes.push(Vec3::new(1.3 * th2.cos(), 1.3 * th2.sin(), z)); // f_i
+        }
+    }
+    let layer = (1 + 2 * n) as u32;
+    let (e, f) = (|i: usize| 1 + 2 * (i % n) as u32, |i: usize| 2 + 2 * (i % n) as u32);
+    let hexes: Vec<[u32; 8]> = (0..n).map(|i| [0, e(i), f(i), e(i + 1), layer, layer + e(i), layer + f(i), layer + e(i + 1)]).collect();
+    let top: Vec<splinecontact::mesh::HexFace> = (0..n as u32).map(|h| splinecontact::mesh::HexFace { element: h, local: 1 }).collect();
+    let m = Mesh {
+        node_tags: (1..=nodes.len() as u64).collect(),
+        nodes: nodes.iter().map(|p| [p.x, p.y, p.z]).collect(),
+        hex_body: vec![0; n],
+        hexes,
+        bodies: vec![splinecontact::mesh::Body { name: "b".into(), physical_tag: 1 }],
+        node_sets: vec![splinecontact::mesh::NodeSet { name: "origin".into(), physical_tag: 2, dim: 0, nodes: vec![0] }],
+        face_sets: vec![FaceSet { name: "m".into(), physical_tag: 3, quad_tags: (1..=n as u64).collect(), faces: top }],
+        element_tags: (1..=n as u64).collect(),
+    };
+    refused(&m, "p:origin:m", &["pair 'p': master face set 'm' has no smooth master", "one grid:", "several grids: it splits into 15 grids", "too small for orders [3, 3]", "subdivision:", "valence 15"]);
+    let dir = tempdir();
+    let p = write_mesh(dir.path(), &m);
+    let (o, _) = tag(dir.path(), &p, &["f:origin:m:facet"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
 #[test]
 fn faces_meeting_at_a_point_are_refused() {
     let m = block_with_top([2, 2, 1], |e| e == 0 || e == 3);

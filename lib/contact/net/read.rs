@@ -64,7 +64,7 @@ pub fn smooth_net(mesh: &Mesh, name: &str, orders: [usize; 2]) -> Result<SmoothN
 }
 
 /// Whether the Catmull–Clark surface can be built on `net`, the quads of the face set
-/// `master` (its boundary nodes in at most 2 faces, valences 3–14), the culprit named
+/// `master` (interior valences 3–14, a support of at most 36 nodes per face), the culprit named
 /// by gmsh tags.
 pub fn check_subdivision(mesh: &Mesh, master: &str, net: &MasterNet) -> Result<(), String> {
     use crate::spline::subdivision::SubdivisionError as E;
