@@ -33,20 +33,32 @@ fn wavy_grid(nx: usize, ny: usize) -> Vec<Vec3> {
 /// Face node cycles of sector `i` are rotated by `i mod 4`, so the vertex sits at
 /// every corner index somewhere.
 fn star_mesh(n: usize, r: usize, lift: f64) -> (QuadControlMesh, Vec<Vec3>) {
-    let mut ids: HashMap<(usize, usize, usize), u32> = HashMap::new();
+    sector_mesh(n, r, std::f64::consts::TAU, true, lift)
+}
+
+/// `k` sectors of `r × r` quads around node 0, sector `i` spanning the unit vectors
+/// `d_i`, `d_{i+1}` at angles `spread·i/k` and `spread·(i+1)/k`, its point `(a, b)`
+/// at `a d_i + b d_{i+1}`, lifted by `lift` times a smooth bump; `closed`: the last
+/// sector meets the first (spread 2π). Face node cycles of sector `i` are rotated by
+/// `i mod 4`.
+fn sector_mesh(k: usize, r: usize, spread: f64, closed: bool, lift: f64) -> (QuadControlMesh, Vec<Vec3>) {
+    let mut ids: HashMap<(usize, usize, usize, usize), u32> = HashMap::new();
     let mut x = Vec::new();
+    let line = |i: usize| if closed { i % k } else { i };
     let d = |i: usize| {
-        let th = 2.0 * std::f64::consts::PI * (i % n) as f64 / n as f64;
+        let th = spread * line(i) as f64 / k as f64;
         Vec3::new(th.cos(), th.sin(), 0.0)
     };
     let mut id = |i: usize, a: usize, b: usize| -> u32 {
-        // canonical key: (a, 0) of sector i is (0, a) of sector i − 1; the centre is one node
+        // one key per point: the centre, a point on the line between two sectors, or inside one
         let key = if a == 0 && b == 0 {
-            (0, 0, 0)
+            (0, 0, 0, 0)
         } else if b == 0 {
-            ((i + n - 1) % n, 0, a)
+            (1, line(i), a, 0)
+        } else if a == 0 {
+            (1, line(i + 1), b, 0)
         } else {
-            (i % n, a, b)
+            (2, i, a, b)
         };
         *ids.entry(key).or_insert_with(|| {
             let mut p = d(i) * a as f64 + d(i + 1) * b as f64;
@@ -56,7 +68,7 @@ fn star_mesh(n: usize, r: usize, lift: f64) -> (QuadControlMesh, Vec<Vec3>) {
         })
     };
     let mut faces = Vec::new();
-    for i in 0..n {
+    for i in 0..k {
         for b in 0..r {
             for a in 0..r {
                 let mut q = [id(i, a, b), id(i, a + 1, b), id(i, a + 1, b + 1), id(i, a, b + 1)];
@@ -811,47 +823,11 @@ fn small_tori_are_periodic_bicubic_splines() {
 
 // ---------------------------------------------------------------- 8. boundary nodes in 3+ faces
 
-/// An open fan of `k` sectors of `r × r` quads around node 0 on the boundary, sector
-/// `i` spanning the unit vectors at angles `spread·i/k` and `spread·(i+1)/k`; its point
-/// `(a, b)` at `a d_i + b d_{i+1}`, lifted by `lift` times a smooth bump. Node 0 lies
-/// in `k` faces; with `k = 3`, `spread = 3π/2` the net is the integer grid of an L
-/// (a concave corner), with `spread = π` node 0 sits on a straight edge. Face node
-/// cycles of sector `i` are rotated by `i mod 4`.
+/// An open fan of `k` sectors around node 0 on the boundary ([`sector_mesh`]): node 0
+/// lies in `k` faces; with `k = 3`, `spread = 3π/2` the net is the integer grid of an
+/// L (a concave corner), with `spread = π` node 0 sits on a straight edge.
 fn fan_mesh(k: usize, r: usize, spread: f64, lift: f64) -> (QuadControlMesh, Vec<Vec3>) {
-    let mut ids: HashMap<(usize, usize, usize, usize), u32> = HashMap::new();
-    let mut x = Vec::new();
-    let d = |i: usize| {
-        let th = spread * i as f64 / k as f64;
-        Vec3::new(th.cos(), th.sin(), 0.0)
-    };
-    let mut id = |i: usize, a: usize, b: usize| -> u32 {
-        let key = if a == 0 && b == 0 {
-            (0, 0, 0, 0)
-        } else if b == 0 {
-            (1, i, a, 0)
-        } else if a == 0 {
-            (1, i + 1, b, 0)
-        } else {
-            (2, i, a, b)
-        };
-        *ids.entry(key).or_insert_with(|| {
-            let mut p = d(i) * a as f64 + d(i + 1) * b as f64;
-            p.z = lift * ((0.7 * p.x).sin() + 0.5 * (0.9 * p.y + 0.3).cos() + 0.2 * p.x * p.y);
-            x.push(p);
-            (x.len() - 1) as u32
-        })
-    };
-    let mut faces = Vec::new();
-    for i in 0..k {
-        for b in 0..r {
-            for a in 0..r {
-                let mut q = [id(i, a, b), id(i, a + 1, b), id(i, a + 1, b + 1), id(i, a, b + 1)];
-                q.rotate_left(i % 4);
-                faces.push(q);
-            }
-        }
-    }
-    (QuadControlMesh { n_nodes: x.len(), faces }, x)
+    sector_mesh(k, r, spread, false, lift)
 }
 
 /// Whether node `v` lies on the open boundary (some edge at it has one face).
