@@ -76,7 +76,6 @@ pub fn check_subdivision(mesh: &Mesh, master: &str, net: &MasterNet) -> Result<(
         format!("quad {quad}")
     };
     Err(match e {
-        E::UnsupportedBoundaryNode { node: k, faces } => format!("boundary node {} (gmsh tag) lies in {faces} faces: concave corners and extraordinary boundary nodes are not supported (boundary nodes must lie in 1 or 2 faces)", node(k)),
         E::ValenceTooLow { node: k, valence } => format!("interior node {} (gmsh tag) has valence {valence}; Catmull–Clark needs at least 3", node(k)),
         E::ValenceTooHigh { node: k, valence, max } => format!("interior node {} (gmsh tag) has valence {valence}, above the supported {max}", node(k)),
         E::NonManifoldVertex { node: k, .. } => format!("the faces around node {} (gmsh tag) do not form one fan", node(k)),

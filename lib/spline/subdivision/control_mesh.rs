@@ -21,11 +21,6 @@ pub enum SubdivisionError {
     InconsistentOrientation { nodes: [u32; 2], faces: [usize; 2] },
     #[error("the {faces} faces around node {node} do not form one fan (a fan of {fan} found): non-manifold vertex")]
     NonManifoldVertex { node: u32, faces: usize, fan: usize },
-    #[error(
-        "boundary node {node} lies in {faces} faces: concave corners and boundary extraordinary vertices \
-         are not supported (boundary nodes must lie in 1 or 2 faces)"
-    )]
-    UnsupportedBoundaryNode { node: u32, faces: usize },
     #[error("interior node {node} has valence {valence}; Catmull–Clark needs at least 3")]
     ValenceTooLow { node: u32, valence: usize },
     #[error("interior node {node} has valence {valence} above the supported {max} (2N+8 ≤ 36 nodes)")]

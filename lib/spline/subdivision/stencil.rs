@@ -14,7 +14,8 @@
 //! bicubic B-spline patch, whose boundary curve is the cubic B-spline of the boundary
 //! nodes (`(φ + 4v + w)/6 = v` on the control polygon) and which passes through convex
 //! corners. A boundary node in three or more faces (a concave corner or a boundary
-//! extraordinary vertex) has no such extension: [`SubdivisionError::UnsupportedBoundaryNode`].
+//! extraordinary vertex) has no such extension; its faces are evaluated by
+//! [`super::boundary_vertex`].
 //!
 //! **Stencil order around a corner of valence N** (Stam 1998, fig. 1, in our own
 //! numbering): the corner is point 0; ring face `i` is `(0, e_i, f_i, e_{i+1})` with
@@ -264,7 +265,8 @@ pub(super) fn local_mesh<N: Net>(net: &N, face: usize) -> Result<(LocalMesh, Vec
         let ring = net.ring(v);
         let ring = ring.as_ref();
         if ring.boundary && ring.faces.len() > 2 {
-            return Err(SubdivisionError::UnsupportedBoundaryNode { node: v, faces: ring.faces.len() });
+            // no phantom extension: such faces are evaluated by `boundary_vertex`
+            return Err(SubdivisionError::StencilIncomplete { face });
         }
         for &(g, _) in &ring.faces {
             add_face(net.quad(g).map(PointKey::Node), &mut keys, &mut faces);
