@@ -357,7 +357,7 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
                     }
                     // mortar: first the same step again, the segmentation held early
                     // (`Newton::early_segmentation_hold`); then the cutbacks, still so
-                    if !newton.early_segmentation_hold && newton.contact.iter().any(|c| c.mortar_skipped_cells().is_some()) {
+                    if !newton.early_segmentation_hold && newton.contact.iter().any(|c| c.is_mortar()) {
                         newton.early_segmentation_hold = true;
                         log.line(&format!("increment {}/{n_inc} at load factor {lambda:.6}: {failure}; solving it again with the mortar segmentation held from a relative residual of 1e-1", k + 1));
                         continue;

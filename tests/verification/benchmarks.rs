@@ -6,7 +6,7 @@
 
 use std::path::Path;
 
-use crate::common::{python_script, repo, run, stderr, staged_meshes, tempdir};
+use crate::common::{python_script, repo, run, stderr, staged_meshes, staged_pipeline, tempdir};
 use splinecontact::format::scres::Results;
 
 fn staged(pipeline: &str) -> tempfile::TempDir {
@@ -236,8 +236,7 @@ increments: {count: 5, max_cutbacks: 1}\n";
 /// pinned to ±5 % (a change of method moves it by more; it is then to be measured again).
 #[test]
 fn hertz3d_subdivision_master_beats_facets() {
-    let dir = staged_meshes(&["hertz3d.msh"]);
-    std::fs::copy(repo().join("pipelines/hertz3d.yaml"), dir.path().join("pipelines/hertz3d.yaml")).unwrap();
+    let dir = staged_pipeline("hertz3d", &["hertz3d.msh"]);
     let o = run("sc-pipeline", &["pipelines/hertz3d.yaml"], dir.path());
     assert!(o.status.success(), "hertz3d.yaml: {}", stderr(&o));
     assert!(stderr(&o).contains("subdivision orders [4, 4]"), "sc-tag's choice: {}", stderr(&o));
@@ -280,8 +279,7 @@ fn hertz3d_subdivision_master_beats_facets() {
 ///   (measured 76 against 131).
 #[test]
 fn punch_on_an_unstructured_block_has_a_catmull_clark_master() {
-    let dir = staged_meshes(&["punch.msh"]);
-    std::fs::copy(repo().join("pipelines/punch.yaml"), dir.path().join("pipelines/punch.yaml")).unwrap();
+    let dir = staged_pipeline("punch", &["punch.msh"]);
     let o = run("sc-pipeline", &["pipelines/punch.yaml"], dir.path());
     assert!(o.status.success(), "punch.yaml: {}", stderr(&o));
     assert!(stderr(&o).contains("354 quads on 383 nodes, subdivision orders [4, 4]"), "sc-tag's choice: {}", stderr(&o));

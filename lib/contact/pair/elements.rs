@@ -172,6 +172,11 @@ impl PairSolver {
         (self.n_active() - slip, slip)
     }
 
+    /// Whether the pair integrates under `integration: mortar`.
+    pub fn is_mortar(&self) -> bool {
+        self.mortar.is_some()
+    }
+
     /// Mortar pairs: the master cells left out of the last integration because their
     /// image over a slave face was not convex (`contact::mortar::segment`).
     pub fn mortar_skipped_cells(&self) -> Option<usize> {

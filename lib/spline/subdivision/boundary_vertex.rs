@@ -32,7 +32,7 @@ use std::borrow::Cow;
 use std::collections::HashMap;
 
 use super::catmull_clark::{subdivide_with, ValenceTables};
-use super::control_mesh::{QuadControlMesh, SubdivisionError};
+use super::control_mesh::QuadControlMesh;
 use super::stencil::{grid_index, local_mesh, Boundary, LocalMesh, Net, OpenRing};
 use super::topology::{Ring, Topology};
 
@@ -205,9 +205,7 @@ fn boundary_limit(lm: &LocalMesh, bd: &Boundary, g: usize, corner: usize) -> Res
     match bd.points.get(&v) {
         Some(true) => Ok(lm.points[v].clone()),
         Some(false) => {
-            let (fan, _) = lm.fan(g, corner);
-            let (&(g0, c0), &(g1, c1)) = (fan.first().ok_or(OpenRing)?, fan.last().ok_or(OpenRing)?);
-            let (l, r) = (lm.faces[g0][(c0 + 1) % 4], lm.faces[g1][(c1 + 3) % 4]);
+            let (l, r) = lm.fan_ends(g, corner);
             Ok(lm.points[v].iter().zip(&lm.points[l]).zip(&lm.points[r]).map(|((x, y), z)| (4.0 * x + y + z) / 6.0).collect())
         }
         None => Err(OpenRing),
@@ -267,9 +265,4 @@ pub(super) fn corner_tables(lm: &LocalMesh, bd: &Boundary, g: usize, r: usize) -
 /// node in three or more faces.
 pub(super) fn touches_irregular_boundary(mesh: &QuadControlMesh, topo: &Topology, face: usize) -> bool {
     mesh.faces[face].iter().any(|&v| is_irregular_boundary(topo, v))
-}
-
-/// Error of a face whose neighbourhood does not form the stencils this needs.
-pub(super) fn incomplete(face: usize) -> impl Fn(OpenRing) -> SubdivisionError {
-    move |_| SubdivisionError::StencilIncomplete { face }
 }

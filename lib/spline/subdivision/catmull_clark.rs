@@ -123,9 +123,7 @@ pub(super) fn subdivide_with(
         let Ok(ring) = mesh.ring(f, c) else {
             // (B2) on a boundary point whose fan runs from boundary edge to boundary edge
             let Some((bd, &corner)) = boundary.and_then(|bd| bd.points.get(&v).map(|c| (bd, c))) else { continue };
-            let (fan, _) = mesh.fan(f, c);
-            let (&(g0, c0), &(g1, c1)) = (fan.first().expect("fan starts non-empty"), fan.last().expect("fan starts non-empty"));
-            let (l, r) = (mesh.faces[g0][(c0 + 1) % 4], mesh.faces[g1][(c1 + 3) % 4]);
+            let (l, r) = mesh.fan_ends(f, c);
             if !bd.is_edge(v, l) || !bd.is_edge(v, r) {
                 continue;
             }

@@ -127,6 +127,18 @@ pub struct CatmullClark {
     corner_tables: Vec<ValenceTables>,
 }
 
+/// Where a face's support nodes and pieces begin ([`CatmullClark::begin_face`]).
+#[derive(Debug, Clone, Copy)]
+struct FaceStart {
+    support: usize,
+    pieces: usize,
+}
+
+/// The error of face `face` whose neighbourhood does not form the stencils it needs.
+fn incomplete(face: usize) -> impl Fn(OpenRing) -> SubdivisionError {
+    move |_| SubdivisionError::StencilIncomplete { face }
+}
+
 /// Parameter positions of a face's corners.
 const CORNERS: [[f64; 2]; 4] = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
 
@@ -162,67 +174,73 @@ impl CatmullClark {
                 continue;
             }
             let (local, support) = local_mesh(&GlobalNet { mesh, topo: &topo }, f)?;
-            if support.len() > MAX_NODES {
-                return Err(SubdivisionError::SupportTooLarge { face: f, nodes: support.len(), max: MAX_NODES });
-            }
-            let s0 = cc.support.len();
-            cc.support.extend(&support);
-            let p0 = cc.pieces.len();
-            let incomplete = |_| SubdivisionError::StencilIncomplete { face: f };
+            let start = cc.begin_face(f, &support)?;
+            let incomplete = incomplete(f);
             let mut valences = [0; 4];
             for (c, n) in valences.iter_mut().enumerate() {
-                *n = local.valence(0, c).map_err(incomplete)?;
+                *n = local.valence(0, c).map_err(&incomplete)?;
             }
             let ev: Vec<usize> = (0..4).filter(|&c| valences[c] != 4).collect();
             let kind = match ev.as_slice() {
                 [] => {
-                    cc.push_piece(&local, 0, 0, CORNERS).map_err(incomplete)?;
+                    cc.push_piece(&local, 0, 0, CORNERS).map_err(&incomplete)?;
                     FaceKind::Regular
                 }
                 &[r] => {
-                    cc.push_piece(&local, 0, r, CORNERS).map_err(incomplete)?;
+                    cc.push_piece(&local, 0, r, CORNERS).map_err(&incomplete)?;
                     FaceKind::Extraordinary { valence: valences[r] }
                 }
                 _ => {
                     let (fine, children) = subdivide(&local);
                     for (c, child) in children[0].iter().enumerate() {
                         let child = child.ok_or(SubdivisionError::StencilIncomplete { face: f })?;
-                        cc.push_piece(&fine, child, 0, quarter(c)).map_err(incomplete)?;
+                        cc.push_piece(&fine, child, 0, quarter(c)).map_err(&incomplete)?;
                     }
                     FaceKind::Split
                 }
             };
-            for p in &cc.pieces[p0..] {
-                if let Some(n) = p.valence {
-                    if cc.valences[n].is_none() {
-                        cc.valences[n] = Some(ValenceTables::new(n).expect("the canonical stencil mesh is complete"));
-                    }
-                }
-            }
-            let q = mesh.faces[f];
-            let across = [0, 1, 2, 3].map(|c| topo.half_edge(q[(c + 1) % 4], q[c]));
-            cc.faces.push(FaceData { support: (s0, support.len()), pieces: (p0, cc.pieces.len() - p0), kind, across });
+            cc.end_face(&topo, mesh.faces[f], start, kind);
         }
         Ok(cc)
+    }
+
+    /// Starts face `f` with its support: where its support and pieces begin.
+    fn begin_face(&mut self, f: usize, support: &[u32]) -> Result<FaceStart, SubdivisionError> {
+        if support.len() > MAX_NODES {
+            return Err(SubdivisionError::SupportTooLarge { face: f, nodes: support.len(), max: MAX_NODES });
+        }
+        let start = FaceStart { support: self.support.len(), pieces: self.pieces.len() };
+        self.support.extend(support);
+        Ok(start)
+    }
+
+    /// Ends the face `q` begun at `start`: the valence tables its pieces need, its
+    /// neighbours across its edges, its record.
+    fn end_face(&mut self, topo: &Topology, q: [u32; 4], start: FaceStart, kind: FaceKind) {
+        for p in &self.pieces[start.pieces..] {
+            if let Some(n) = p.valence {
+                if self.valences[n].is_none() {
+                    self.valences[n] = Some(ValenceTables::new(n).expect("the canonical stencil mesh is complete"));
+                }
+            }
+        }
+        let across = [0, 1, 2, 3].map(|c| topo.half_edge(q[(c + 1) % 4], q[c]));
+        let support = (start.support, self.support.len() - start.support);
+        self.faces.push(FaceData { support, pieces: (start.pieces, self.pieces.len() - start.pieces), kind, across });
     }
 
     /// Adds face `f`, one of whose corners is a boundary node in three or more faces
     /// ([`boundary_vertex`]): with that one irregular corner, its tables; with more,
     /// one subdivision step (with the boundary rules) and a piece per quarter.
     fn push_boundary_corner_face(&mut self, mesh: &QuadControlMesh, topo: &Topology, f: usize) -> Result<(), SubdivisionError> {
-        let incomplete = boundary_vertex::incomplete(f);
+        let incomplete = incomplete(f);
         let (real, bd, support) = boundary_vertex::real_local_mesh(mesh, topo, f);
-        if support.len() > MAX_NODES {
-            return Err(SubdivisionError::SupportTooLarge { face: f, nodes: support.len(), max: MAX_NODES });
-        }
+        let start = self.begin_face(f, &support)?;
         let q = mesh.faces[f];
         let irregular = |v: u32| {
             let ring = &topo.rings[v as usize];
             if ring.boundary { ring.faces.len() > 2 } else { ring.faces.len() != 4 }
         };
-        let s0 = self.support.len();
-        self.support.extend(&support);
-        let p0 = self.pieces.len();
         let ev: Vec<usize> = (0..4).filter(|&c| irregular(q[c])).collect();
         if let &[r] = ev.as_slice() {
             let tables = boundary_vertex::corner_tables(&real, &bd, 0, r).map_err(&incomplete)?;
@@ -241,16 +259,8 @@ impl CatmullClark {
                 }
             }
         }
-        for p in &self.pieces[p0..] {
-            if let Some(n) = p.valence {
-                if self.valences[n].is_none() {
-                    self.valences[n] = Some(ValenceTables::new(n).expect("the canonical stencil mesh is complete"));
-                }
-            }
-        }
-        let across = [0, 1, 2, 3].map(|c| topo.half_edge(q[(c + 1) % 4], q[c]));
-        let kind = FaceKind::BoundaryCorner { pieces: self.pieces.len() - p0 };
-        self.faces.push(FaceData { support: (s0, support.len()), pieces: (p0, self.pieces.len() - p0), kind, across });
+        let kind = FaceKind::BoundaryCorner { pieces: self.pieces.len() - start.pieces };
+        self.end_face(topo, q, start, kind);
         Ok(())
     }
 

@@ -155,6 +155,15 @@ impl LocalMesh {
         (fan, false)
     }
 
+    /// The far ends `(l, r)` of the two edges that bound the open fan around corner
+    /// `corner` of `face` ([`Self::fan`]): `v → l` in its first face, `r → v` in its
+    /// last (on a boundary, v's neighbours along it).
+    pub fn fan_ends(&self, face: usize, corner: usize) -> (usize, usize) {
+        let (fan, _) = self.fan(face, corner);
+        let ((g0, c0), (g1, c1)) = (fan[0], fan[fan.len() - 1]);
+        (self.faces[g0][(c0 + 1) % 4], self.faces[g1][(c1 + 3) % 4])
+    }
+
     /// Valence of corner `corner` of `face` (its number of faces).
     pub fn valence(&self, face: usize, corner: usize) -> Result<usize, OpenRing> {
         self.ring(face, corner).map(|r| r.len())
