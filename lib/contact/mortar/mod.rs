@@ -481,7 +481,8 @@ fn segment(trace: &Trace, x_net: &[Vec3], plane: &FacePlane, cell: usize, seg: &
     let corners = trace.corners(cell);
     let mut quad = [P2::zeros(); 4];
     for (l, q) in quad.iter_mut().enumerate() {
-        let n = trace.evaluate(trace.corner_parameter(cell, l), cell).n_bar;
+        // along the node's normal, which every cell around it uses: the images tile
+        let n = trace.node_normal(corners[l]);
         let Some(e) = plane.meet(&x_net[corners[l] as usize], &n) else { return Segment::Empty };
         *q = e;
     }

@@ -10,10 +10,12 @@
 //! to it there):
 //! ```text
 //! 1. the slave face's corners are projected onto the plane: a convex quadrilateral;
-//! 2. the cell's four corners are carried along the cell's normal onto the plane
-//!    (those lines bound the points whose foot lies in the cell, so the segment
-//!    edges follow the integrand's kinks also where the faces are inclined to each
-//!    other): another quadrilateral;
+//! 2. the cell's four corners are carried onto the plane along their nodes'
+//!    normals ([`super::trace::Trace::node_normal`], one per net node, the same for
+//!    every cell around it, so the cells' images tile the plane; those lines bound
+//!    the points whose foot lies in the cell, so the segment edges follow the
+//!    integrand's kinks also where the faces are inclined to each other): another
+//!    quadrilateral;
 //! 3. the face clipped by the cell's image (Sutherland–Hodgman, both convex) is the
 //!    segment, a convex polygon;
 //! 4. its vertices are taken back to the face's parameter η (the projected face's

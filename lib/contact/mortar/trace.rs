@@ -28,6 +28,10 @@ pub struct Trace {
     /// The cells around every net node (`around[offsets[k]..offsets[k + 1]]`).
     offsets: Vec<u32>,
     around: Vec<u32>,
+    /// Per net node, the mean of the unit normals of its cells' facets at it: the
+    /// direction along which every cell around the node carries it onto a slave
+    /// face's plane ([`Self::node_normal`]).
+    normals: Vec<Vec3>,
 }
 
 impl Trace {
@@ -55,15 +59,41 @@ impl Trace {
                 count[k as usize] += 1;
             }
         }
-        Ok(Self { facets, cells, offsets, around })
+        let mut trace = Self { facets, cells, offsets, around, normals: vec![Vec3::zeros(); net.nodes.len()] };
+        trace.node_normals(x_net);
+        Ok(trace)
     }
 
     /// New control point positions.
     pub fn update(&mut self, x_net: &[Vec3]) -> Result<(), SplineError> {
         match &mut self.facets {
-            Facets::Grid { projector, .. } => projector.update(x_net),
-            Facets::Quads(projector) => projector.update(x_net),
+            Facets::Grid { projector, .. } => projector.update(x_net)?,
+            Facets::Quads(projector) => projector.update(x_net)?,
         }
+        self.node_normals(x_net);
+        Ok(())
+    }
+
+    /// The nodes' normals at `x_net`: the facet of cell `[x_0, x_1, x_2, x_3]` has at
+    /// its corner l the normal (x_{l+1} − x_l) × (x_{l−1} − x_l) (= ā_1 × ā_2 there).
+    fn node_normals(&mut self, x_net: &[Vec3]) {
+        self.normals.iter_mut().for_each(|n| *n = Vec3::zeros());
+        for q in &self.cells {
+            for l in 0..4 {
+                let x = |i: usize| x_net[q[i % 4] as usize];
+                if let Some(n) = (x(l + 1) - x(l)).cross(&(x(l + 3) - x(l))).try_normalize(0.0) {
+                    self.normals[q[l] as usize] += n;
+                }
+            }
+        }
+        self.normals.iter_mut().for_each(|n| *n = n.try_normalize(0.0).unwrap_or_else(Vec3::zeros));
+    }
+
+    /// The normal of net node `k` ([`Self::node_normals`]): shared by every cell
+    /// around the node, so the cells' images in a plane tile it without gaps or
+    /// overlaps.
+    pub fn node_normal(&self, k: u32) -> Vec3 {
+        self.normals[k as usize]
     }
 
     pub fn n_cells(&self) -> usize {
@@ -86,18 +116,6 @@ impl Trace {
         match &self.facets {
             Facets::Grid { cells_a, .. } => [c % cells_a, c / cells_a],
             Facets::Quads(_) => [c, 0],
-        }
-    }
-
-    /// The cell's parameter at its corner `l` (cycle order).
-    pub fn corner_parameter(&self, c: usize, l: usize) -> [f64; 2] {
-        const UNIT: [[f64; 2]; 4] = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
-        match &self.facets {
-            Facets::Grid { projector, .. } => {
-                let (lo, hi) = projector.facets().cell_bounds(self.element(c));
-                [[lo[0], lo[1]], [hi[0], lo[1]], [hi[0], hi[1]], [lo[0], hi[1]]][l]
-            }
-            Facets::Quads(_) => UNIT[l],
         }
     }
 
