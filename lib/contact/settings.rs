@@ -74,6 +74,9 @@ pub struct PairSettings {
     pub max_augmentations: u32,
     /// Retries of a failed solve with half the last Uzawa update (`solver::uzawa`).
     pub update_halvings: u32,
+    /// Over-relaxation ω of the Uzawa update, λ_N ← min(0, λ_N + ω (t_N − λ_N)),
+    /// 1 ≤ ω < 2 (1: the plain update λ_N ← t_N).
+    pub uzawa_relaxation: f64,
     /// Coulomb coefficient μ and tangential penalty ε_T (μ = 0: frictionless).
     pub mu: f64,
     pub eps_t: f64,

@@ -468,6 +468,10 @@ pub struct ContactSetup {
     /// the update before the load step is cut back (`solver::uzawa`).
     #[serde(default = "default_update_halvings")]
     pub update_halvings: u32,
+    /// Over-relaxation ω of the Uzawa update, λ_N ← min(0, λ_N + ω (t_N − λ_N)),
+    /// 1 ≤ ω < 2 (default 1: λ_N ← t_N; `docs/theory/contact.md`).
+    #[serde(default = "default_uzawa_relaxation", skip_serializing_if = "is_one")]
+    pub uzawa_relaxation: f64,
     /// Coulomb friction coefficient μ (0: frictionless).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub mu: f64,
@@ -501,6 +505,14 @@ fn is_standard(v: &MortarMultipliers) -> bool {
 
 fn is_node(v: &Integration) -> bool {
     *v == Integration::Node
+}
+
+fn default_uzawa_relaxation() -> f64 {
+    1.0
+}
+
+fn is_one(v: &f64) -> bool {
+    *v == 1.0
 }
 
 fn is_false(v: &bool) -> bool {

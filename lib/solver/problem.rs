@@ -191,6 +191,9 @@ fn contact_definitions(mesh: &Mesh, pairs: &[ContactPair], setup: &SolveSetup, f
             (mu, None) if mu > 0.0 => eps_n, // default: the normal penalty
             (_, e) => e.unwrap_or(0.0),
         };
+        if !(c.uzawa_relaxation >= 1.0 && c.uzawa_relaxation < 2.0) {
+            return Err(bad(format!("uzawa_relaxation must lie in [1, 2) (1: the plain Uzawa update), found {}", c.uzawa_relaxation)));
+        }
         if !(c.stabilization.is_finite() && c.stabilization >= 0.0) {
             return Err(bad(format!("stabilization must be zero or positive, found {}", c.stabilization)));
         }
@@ -214,7 +217,7 @@ fn contact_definitions(mesh: &Mesh, pairs: &[ContactPair], setup: &SolveSetup, f
         };
         out.push(ContactDefinition {
             pair: pair.clone(),
-            settings: PairSettings { eps_n, enforcement: c.enforcement, penetration_tolerance, max_augmentations: c.max_augmentations, update_halvings: c.update_halvings, mu: c.mu, eps_t, stabilization: c.stabilization, integration: c.integration, multipliers: c.multipliers, transfer: c.transfer },
+            settings: PairSettings { eps_n, enforcement: c.enforcement, penetration_tolerance, max_augmentations: c.max_augmentations, update_halvings: c.update_halvings, uzawa_relaxation: c.uzawa_relaxation, mu: c.mu, eps_t, stabilization: c.stabilization, integration: c.integration, multipliers: c.multipliers, transfer: c.transfer },
             eps_n_default,
             areas,
             slave_faces,

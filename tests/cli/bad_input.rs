@@ -131,10 +131,11 @@ fn contact_setup_mistakes() {
     let o = run("sc-tag", &["p.scmesh", "--pair", "contact:upper_bottom:lower_top", "-o", "p.sccontact"], dir.path());
     assert!(o.status.success(), "{}", stderr(&o));
     let base = "materials:\n  - {body: upper, model: neo_hookean, E: 1.0e9, nu: 0.3}\n  - {body: lower, model: neo_hookean, E: 1.0e10, nu: 0.3}\nconstraints:\n  - {set: lower_base, fix: [x, y, z]}\n";
-    let cases: [(&str, &str, &[&str]); 11] = [
+    let cases: [(&str, &str, &[&str]); 12] = [
         ("contact:\n  - {pair: contact, eps_n: 0.0}\n", "p.sccontact", &["bad.yaml", "eps_n must be a positive number, found 0"]),
         ("contact:\n  - {pair: contact, eps_n: 1.0e5, mu: -0.2, eps_t: 1.0}\n", "p.sccontact", &["bad.yaml", "mu must be zero or positive"]),
         ("contact:\n  - {pair: contact, eps_n: 1.0e5, stabilization: -0.1}\n", "p.sccontact", &["bad.yaml", "contact pair 'contact'", "stabilization must be zero or positive, found -0.1"]),
+        ("contact:\n  - {pair: contact, eps_n: 1.0e5, uzawa_relaxation: 2.0}\n", "p.sccontact", &["bad.yaml", "contact pair 'contact'", "uzawa_relaxation must lie in [1, 2)", "found 2"]),
         ("contact:\n  - {pair: contact, eps_n: 1.0e5, mu: 0.2, eps_t: 0.0}\n", "p.sccontact", &["bad.yaml", "eps_t must be a positive number"]),
         ("contact:\n  - {pair: contact, eps_n: 1.0e5, mu: 0.2, eps_t: 1.0}\nlinear_solver: cholesky\n", "p.sccontact", &["cholesky needs a symmetric tangent", "friction", "use auto or lu"]),
         ("contact:\n  - {pair: contact, eps_n: 1.0e5}\nloads:\n  - {set: load_node, force: [0, 0, -1], curve: ramp2}\n", "p.sccontact", &["bad.yaml", "load 1 uses curve 'ramp2', which `curves` does not define (it has: none)"]),

@@ -67,12 +67,21 @@ impl PairSolver {
             && self.augmentations < self.settings.max_augmentations
     }
 
-    /// Uzawa update (sec. 4): λ_N ← t_N = min(0, λ_N + ε_N g_N); with friction the
-    /// tangential multiplier too (eq. 4.7's Δλ_T): a sticking node keeps its anchor ξ̄_n
-    /// and takes t_{T,n} ← t_T, so the next solve drives its elastic slip to zero; a
-    /// sliding node's slip is plastic: it is re-anchored, ξ̄_n ← ξ̄, t_{T,n} ← t_T.
+    /// Uzawa update (sec. 4): λ_N ← t_N = min(0, λ_N + ε_N g_N), or over-relaxed,
+    /// λ_N ← min(0, λ_N + ω (t_N − λ_N)) with the pair's `uzawa_relaxation` ω
+    /// (docs/theory/contact.md); with friction the tangential multiplier too (eq.
+    /// 4.7's Δλ_T): a sticking node keeps its anchor ξ̄_n and takes t_{T,n} ← t_T, so
+    /// the next solve drives its elastic slip to zero; a sliding node's slip is
+    /// plastic: it is re-anchored, ξ̄_n ← ξ̄, t_{T,n} ← t_T.
     pub fn augment(&mut self) {
-        self.lambda_n.copy_from_slice(&self.t_n);
+        let omega = self.settings.uzawa_relaxation;
+        if omega == 1.0 {
+            self.lambda_n.copy_from_slice(&self.t_n);
+        } else {
+            for (l, t) in self.lambda_n.iter_mut().zip(&self.t_n) {
+                *l = (*l + omega * (t - *l)).min(0.0);
+            }
+        }
         if self.settings.frictional() {
             for s in 0..self.slaves.len() {
                 if self.status[s] != SlaveStatus::Active {
