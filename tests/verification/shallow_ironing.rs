@@ -185,6 +185,17 @@ const DEFAULT_EPS_N: f64 = 13905.704099821765;
 #[test]
 fn shallow_ironing_default_penalty_does_not_matter() {
     let name = "shallow_ironing";
+    let (r, _) = solve_pipeline(name, "b4", &to_t12(name, "eps_n", (2.0 * DEFAULT_EPS_N).into()));
+    assert!((r.s.last().unwrap() - 2.0).abs() < 1e-9, "the run ends at t = 1.2");
+    let (v, h) = (*r.v.last().unwrap(), *r.h.last().unwrap());
+    eprintln!("{name}, B-spline [2, 4], 2 × default ε_N: V(1.2) {v:.2}, H/V(1.2) {:.4}", h / v);
+    assert!((v / 395.27 - 1.0).abs() < 1e-3, "V(1.2) = {v} with 2 × the default ε_N (default: 395.27)");
+    assert!((h / v - 0.3147).abs() < 2e-3, "H/V(1.2) = {} with 2 × the default ε_N (default: 0.3147)", h / v);
+}
+
+/// The B-spline [2, 4] chain of `name` ended at t = 1.2 (pressing and 2 mm of
+/// sliding, 120 increments), its contact entry given `key: value`.
+fn to_t12(name: &str, key: &str, value: Value) -> String {
     let mut doc: Value = serde_yaml::from_str(&derived_pipeline(name, "b4", true)).unwrap();
     let stages = doc.get_mut("stages").and_then(Value::as_sequence_mut).unwrap();
     let setup = stages.iter_mut().find_map(|s| s.get_mut("solve")).and_then(|s| s.get_mut("setup")).unwrap();
@@ -192,13 +203,8 @@ fn shallow_ironing_default_penalty_does_not_matter() {
     inc.insert("count".into(), 120.into());
     inc.insert("end".into(), 1.2.into());
     let contact = setup.get_mut("contact").and_then(Value::as_sequence_mut).unwrap();
-    contact[0].as_mapping_mut().unwrap().insert("eps_n".into(), (2.0 * DEFAULT_EPS_N).into());
-    let (r, _) = solve_pipeline(name, "b4", &serde_yaml::to_string(&doc).unwrap());
-    assert!((r.s.last().unwrap() - 2.0).abs() < 1e-9, "the run ends at t = 1.2");
-    let (v, h) = (*r.v.last().unwrap(), *r.h.last().unwrap());
-    eprintln!("{name}, B-spline [2, 4], 2 × default ε_N: V(1.2) {v:.2}, H/V(1.2) {:.4}", h / v);
-    assert!((v / 395.27 - 1.0).abs() < 1e-3, "V(1.2) = {v} with 2 × the default ε_N (default: 395.27)");
-    assert!((h / v - 0.3147).abs() < 2e-3, "H/V(1.2) = {} with 2 × the default ε_N (default: 0.3147)", h / v);
+    contact[0].as_mapping_mut().unwrap().insert(key.into(), value);
+    serde_yaml::to_string(&doc).unwrap()
 }
 
 /// The facet chain of `name` as shipped: it must reach the end of the sliding (t = 2;
@@ -338,17 +344,7 @@ const PIN_MORTAR_SURFACE_COULOMB: Pin = Pin { v_15: 399.02, v_rms: 1.087e-4, new
 #[test]
 fn uzawa_over_relaxation_saves_updates() {
     let name = "shallow_ironing";
-    let run = |omega: f64| {
-        let mut doc: Value = serde_yaml::from_str(&derived_pipeline(name, "b4", true)).unwrap();
-        let stages = doc.get_mut("stages").and_then(Value::as_sequence_mut).unwrap();
-        let setup = stages.iter_mut().find_map(|s| s.get_mut("solve")).and_then(|s| s.get_mut("setup")).unwrap();
-        let inc = setup.get_mut("increments").and_then(Value::as_mapping_mut).unwrap();
-        inc.insert("count".into(), 120.into());
-        inc.insert("end".into(), 1.2.into());
-        let contact = setup.get_mut("contact").and_then(Value::as_sequence_mut).unwrap();
-        contact[0].as_mapping_mut().unwrap().insert("uzawa_relaxation".into(), omega.into());
-        solve_pipeline(name, "b4", &serde_yaml::to_string(&doc).unwrap())
-    };
+    let run = |omega: f64| solve_pipeline(name, "b4", &to_t12(name, "uzawa_relaxation", omega.into()));
     let (plain, relaxed) = (run(1.0), run(1.5));
     let (v1, h1) = (*plain.0.v.last().unwrap(), *plain.0.h.last().unwrap());
     let (v2, h2) = (*relaxed.0.v.last().unwrap(), *relaxed.0.h.last().unwrap());
