@@ -75,6 +75,8 @@ impl PairSolver {
     /// plastic: it is re-anchored, ξ̄_n ← ξ̄, t_{T,n} ← t_T.
     pub fn augment(&mut self) {
         let omega = self.settings.uzawa_relaxation;
+        // ω = 1 copies t_N: λ + (t − λ) need not round to t, and the plain update
+        // keeps its results bit for bit
         if omega == 1.0 {
             self.lambda_n.copy_from_slice(&self.t_n);
         } else {
