@@ -1,27 +1,36 @@
-//! The CalculiX comparison tool (`docs/scripts/ccx_compare.py`) at its smallest level,
-//! so that it cannot rot: both programs run the frictional crossed beams on the same
-//! gmsh mesh (2 × 2 × 30 hex8 per beam, 1,593 free dofs) and must agree.
+//! The CalculiX comparison tool (`docs/scripts/ccx_compare.py`), so that it cannot
+//! rot: both programs run the frictional crossed beams at the smallest level (2 × 2 ×
+//! 30 hex8 per beam, 1,593 free dofs) and the Parisch blocks at r = 6 on the same gmsh
+//! mesh, and must agree.
 //! Needs `ccx` (Debian's calculix-ccx; `./test.sh` installs it when run as root).
 
 use crate::common::{python, repo};
 use std::process::Command;
 
-#[test]
-fn crossed_beams_agree_with_calculix_at_the_smallest_level() {
+/// Runs `ccx_compare.py MODEL --levels LEVEL --json`; its one row.
+fn compare(model: &str, level: &str) -> serde_yaml::Value {
     let out = tempfile::tempdir().unwrap();
     let bin_dir = std::path::Path::new(env!("CARGO_BIN_EXE_sc-solve")).parent().unwrap();
     let o = Command::new(python())
         .arg(repo().join("docs/scripts/ccx_compare.py"))
-        .args(["crossed_beams", "--levels", "2", "--threads", "2", "--json", "--out"])
+        .args([model, "--levels", level, "--threads", "2", "--json", "--out"])
         .arg(out.path())
         .env("SC_BIN_DIR", bin_dir)
         .output()
         .expect("python runs");
     let stdout = String::from_utf8_lossy(&o.stdout);
-    assert!(o.status.success(), "ccx_compare.py failed: {}\n{stdout}", String::from_utf8_lossy(&o.stderr));
+    assert!(o.status.success(), "ccx_compare.py {model} failed: {}\n{stdout}", String::from_utf8_lossy(&o.stderr));
     let rows: serde_yaml::Value = serde_yaml::from_str(&stdout).expect("JSON rows");
-    let row = &rows[0];
-    let f = |v: &serde_yaml::Value| v.as_f64().unwrap_or(f64::NAN);
+    rows[0].clone()
+}
+
+fn f(v: &serde_yaml::Value) -> f64 {
+    v.as_f64().unwrap_or(f64::NAN)
+}
+
+#[test]
+fn crossed_beams_agree_with_calculix_at_the_smallest_level() {
+    let row = &compare("crossed_beams", "2");
     assert_eq!(row["dofs"].as_u64(), Some(1593));
     assert_eq!(row["ours"]["ok"].as_bool(), Some(true));
     assert_eq!(row["ccx"]["ok"].as_bool(), Some(true), "{:?}", row["ccx"]);
@@ -39,4 +48,30 @@ fn crossed_beams_agree_with_calculix_at_the_smallest_level() {
     // our Newton iterations (18 measured; +25 %: a regression of the solver shows)
     let its = row["ours"]["newton_iterations"].as_u64().unwrap();
     assert!((10..=23).contains(&its), "{its} Newton iterations");
+}
+
+/// The Parisch blocks at r = 6 (10,042 dofs), the first level where ccx, given our
+/// Newton tolerance of 1e-8, cuts its increment back until it stops: its residual
+/// stalls at 1.4e-7 of its average force (round-off). The script gives it R_n = 1e-6
+/// there (the model's `ccx_ran`, docs/performance.md); both must then finish and agree.
+#[test]
+fn parisch_agrees_with_calculix_where_its_residual_floor_binds() {
+    let row = &compare("parisch", "6");
+    assert_eq!(row["dofs"].as_u64(), Some(10_042));
+    assert_eq!(row["ours"]["ok"].as_bool(), Some(true));
+    assert_eq!(row["ccx"]["ok"].as_bool(), Some(true), "{:?}", row["ccx"]);
+    // Measured: max |u| 0.0517704 (ours) against 0.0517699 (ccx), 9.7e-6: a flat
+    // master (the B-spline over a flat grid is the plane, as ccx's facets), the same
+    // penalty and one increment; what is left are the differences the deck's header
+    // lists (ccx's dev/vol NEO HOOKE against Ciarlet-Simo, its tributary areas in the
+    // current configuration). 1e-4 is ten times that; a wrong load or contact
+    // transfer is off by percents.
+    let du = f(&row["agreement"]["max_u"]);
+    assert!(du < 1e-4, "max |u| differs by {du:e}");
+    // the reaction is the point load, 2e6, in both (measured 2.5e-11 apart)
+    let dr = f(&row["agreement"]["reaction_z"]);
+    assert!(dr < 1e-8, "the support reaction differs by {dr:e}");
+    // ccx converges in 3 iterations, ours in 2 (a cutback or a stall shows)
+    assert_eq!(row["ccx"]["newton_iterations"].as_u64(), Some(3));
+    assert_eq!(row["ours"]["newton_iterations"].as_u64(), Some(2));
 }
