@@ -196,14 +196,27 @@ fn shallow_ironing_default_penalty_does_not_matter() {
 /// The B-spline [2, 4] chain of `name` ended at t = 1.2 (pressing and 2 mm of
 /// sliding, 120 increments), its contact entry given `key: value`.
 fn to_t12(name: &str, key: &str, value: Value) -> String {
-    let mut doc: Value = serde_yaml::from_str(&derived_pipeline(name, "b4", true)).unwrap();
-    let stages = doc.get_mut("stages").and_then(Value::as_sequence_mut).unwrap();
-    let setup = stages.iter_mut().find_map(|s| s.get_mut("solve")).and_then(|s| s.get_mut("setup")).unwrap();
-    let inc = setup.get_mut("increments").and_then(Value::as_mapping_mut).unwrap();
+    let mut doc: Value = serde_yaml::from_str(&with_contact(&derived_pipeline(name, "b4", true), &[(key, value)])).unwrap();
+    let inc = solve_setup(&mut doc).get_mut("increments").and_then(Value::as_mapping_mut).unwrap();
     inc.insert("count".into(), 120.into());
     inc.insert("end".into(), 1.2.into());
-    let contact = setup.get_mut("contact").and_then(Value::as_sequence_mut).unwrap();
-    contact[0].as_mapping_mut().unwrap().insert(key.into(), value);
+    serde_yaml::to_string(&doc).unwrap()
+}
+
+/// The setup of the (one) solve stage of a pipeline document.
+fn solve_setup(doc: &mut Value) -> &mut Value {
+    let stages = doc.get_mut("stages").and_then(Value::as_sequence_mut).unwrap();
+    stages.iter_mut().find_map(|s| s.get_mut("solve")).and_then(|s| s.get_mut("setup")).unwrap()
+}
+
+/// `pipeline` with `entries` (key, value) added to its solve stage's contact entry.
+fn with_contact(pipeline: &str, entries: &[(&str, Value)]) -> String {
+    let mut doc: Value = serde_yaml::from_str(pipeline).unwrap();
+    let contact = solve_setup(&mut doc).get_mut("contact").and_then(Value::as_sequence_mut).unwrap();
+    let entry = contact[0].as_mapping_mut().unwrap();
+    for (key, value) in entries {
+        entry.insert((*key).into(), value.clone());
+    }
     serde_yaml::to_string(&doc).unwrap()
 }
 
@@ -280,13 +293,7 @@ const H_LIMIT: f64 = 0.05;
 /// `pipeline` with the solve stage's contact pair under `integration: mortar` and the
 /// mortar `transfer`.
 fn mortar(pipeline: &str, transfer: &str) -> String {
-    let mut doc: Value = serde_yaml::from_str(pipeline).unwrap();
-    let stages = doc.get_mut("stages").and_then(Value::as_sequence_mut).unwrap();
-    let setup = stages.iter_mut().find_map(|s| s.get_mut("solve")).and_then(|s| s.get_mut("setup")).unwrap();
-    let contact = setup.get_mut("contact").and_then(Value::as_sequence_mut).unwrap();
-    contact[0].as_mapping_mut().unwrap().insert("integration".into(), "mortar".into());
-    contact[0].as_mapping_mut().unwrap().insert("transfer".into(), transfer.into());
-    serde_yaml::to_string(&doc).unwrap()
+    with_contact(pipeline, &[("integration", "mortar".into()), ("transfer", transfer.into())])
 }
 
 /// Issue 25's "large sliding is not worse", measured: the B-spline [2, 4] chains under
@@ -345,12 +352,8 @@ const PIN_MORTAR_SURFACE_COULOMB: Pin = Pin { v_15: 399.02, v_rms: 1.087e-4, new
 #[test]
 fn mortar_surface_transfer_over_relaxed_takes_the_corrections_of_node_to_surface() {
     let name = "shallow_ironing_frictionless";
-    let mut doc: Value = serde_yaml::from_str(&mortar(&derived_pipeline(name, "b4", true), "surface")).unwrap();
-    let stages = doc.get_mut("stages").and_then(Value::as_sequence_mut).unwrap();
-    let setup = stages.iter_mut().find_map(|s| s.get_mut("solve")).and_then(|s| s.get_mut("setup")).unwrap();
-    let contact = setup.get_mut("contact").and_then(Value::as_sequence_mut).unwrap();
-    contact[0].as_mapping_mut().unwrap().insert("uzawa_relaxation".into(), 1.5.into());
-    let run = solve_pipeline(name, "b4", &serde_yaml::to_string(&doc).unwrap());
+    let pipeline = with_contact(&mortar(&derived_pipeline(name, "b4", true), "surface"), &[("uzawa_relaxation", 1.5.into())]);
+    let run = solve_pipeline(name, "b4", &pipeline);
     assert!((run.0.s.last().unwrap() - 5.0).abs() < 1e-9, "{name}: the run ends at t = 1.5");
     let (v, _) = check(&format!("{name}, surface, ω = 1.5, mortar"), &run, &PIN_MORTAR_SURFACE_RELAXED);
     assert!((v / PIN_FRICTIONLESS.v_15 - 1.0).abs() < 0.01, "V(1.5) = {v} against node-to-surface {}", PIN_FRICTIONLESS.v_15);
