@@ -204,26 +204,36 @@ impl Pattern {
             return Err(PatternError::TooManyEntries { nnz });
         }
 
-        // Slot of (row dof, column dof) by binary search in the column.
-        let slot_of = |row: Option<usize>, col: Option<usize>| -> u32 {
-            match (row, col) {
-                (Some(r), Some(c)) => {
-                    let (lo, hi) = (col_ptr[c], col_ptr[c + 1]);
-                    match row_idx[lo..hi].binary_search(&r) {
-                        Ok(k) => (lo + k) as u32,
-                        Err(_) => unreachable!("coupled dofs are in the pattern by construction"),
-                    }
-                }
-                _ => NO_SLOT,
-            }
-        };
+        // Slots of an element's entries. Node blocks are stored whole and the free
+        // numbering is monotone in the global dof, so the free components of one row
+        // node sit in consecutive positions of every column that couples it: one
+        // binary search per (row node, column), not per entry.
         let element_slots = |nodes: &[u32], out: &mut [u32]| {
             let nd = DOFS_PER_NODE * nodes.len();
-            let free = |i: usize| dofs.free(DOFS_PER_NODE * nodes[i / DOFS_PER_NODE] as usize + i % DOFS_PER_NODE);
-            for j in 0..nd {
-                let fj = free(j);
-                for i in 0..nd {
-                    out[i + nd * j] = slot_of(free(i), fj);
+            for (j, col) in out.chunks_exact_mut(nd).enumerate() {
+                let Some(fj) = dofs.free(DOFS_PER_NODE * nodes[j / DOFS_PER_NODE] as usize + j % DOFS_PER_NODE) else {
+                    col.fill(NO_SLOT);
+                    continue;
+                };
+                let (lo, hi) = (col_ptr[fj], col_ptr[fj + 1]);
+                for (&a, block) in nodes.iter().zip(col.chunks_exact_mut(DOFS_PER_NODE)) {
+                    let base = DOFS_PER_NODE * a as usize;
+                    let Some(first) = (0..DOFS_PER_NODE).find_map(|c| dofs.free(base + c)) else {
+                        block.fill(NO_SLOT);
+                        continue;
+                    };
+                    let mut at = match row_idx[lo..hi].binary_search(&first) {
+                        Ok(k) => lo + k,
+                        Err(_) => unreachable!("coupled dofs are in the pattern by construction"),
+                    };
+                    for (c, slot) in block.iter_mut().enumerate() {
+                        *slot = if dofs.is_constrained(base + c) {
+                            NO_SLOT
+                        } else {
+                            at += 1;
+                            (at - 1) as u32
+                        };
+                    }
                 }
             }
         };
@@ -241,9 +251,14 @@ impl Pattern {
             group_slot_offsets.push(group_slot_offsets[group_slot_offsets.len() - 1] + nd * nd);
         }
         let mut group_slots = vec![NO_SLOT; group_slot_offsets[groups.len()]];
-        for (g, nodes) in groups.iter().enumerate() {
-            element_slots(nodes, &mut group_slots[group_slot_offsets[g]..group_slot_offsets[g + 1]]);
+        let mut outs = Vec::with_capacity(groups.len());
+        let mut rest = &mut group_slots[..];
+        for g in 0..groups.len() {
+            let (out, tail) = rest.split_at_mut(group_slot_offsets[g + 1] - group_slot_offsets[g]);
+            outs.push(out);
+            rest = tail;
         }
+        outs.into_par_iter().enumerate().for_each(|(g, out)| element_slots(groups.group(g), out));
 
         let symbolic = SymbolicSparseColMat::new_checked(n_free, n_free, col_ptr, None, row_idx);
         let colouring = colouring.unwrap_or_else(|| Colouring::greedy(n_nodes, hexes.iter().map(|h| &h[..])));

@@ -31,7 +31,8 @@ use crate::contact::law::{ContactElementError, ContactState, FrictionLaw, Normal
 use crate::contact::master::Projector;
 use crate::spline::{SurfacePoint, Vec3};
 
-/// Working rows of one quadrature point, length `m` each (reused between points).
+/// Working rows of one quadrature point over the local dofs of its face (see
+/// [`Local`]); allocated to the element's `m` dofs, the first `d` in use.
 #[derive(Default)]
 struct Rows {
     grad: Vec<f64>,
@@ -45,19 +46,67 @@ struct Rows {
     nf: [Vec<f64>; 2],
 }
 
+/// The dofs one slave face touches: its four corners, then every master node its
+/// quadrature points reach, numbered in the order met (3 local dofs per node). A
+/// face's points are accumulated over these d dofs, d < m, and the face's sums are
+/// added to the element's once per face: the work per point scales with the face,
+/// not with the union of the four faces around the slave node.
+#[derive(Default)]
+struct Local {
+    /// Local node of each element node (`u32::MAX`: not touched by this face).
+    map: Vec<u32>,
+    /// Element dof of each local node's first component.
+    dofs: Vec<usize>,
+}
+
+impl Local {
+    /// The local dof of element dof `dof` (a node's first component), numbering it if new.
+    fn of(&mut self, dof: usize) -> usize {
+        let e = dof / 3;
+        if self.map[e] == u32::MAX {
+            self.map[e] = self.dofs.len() as u32;
+            self.dofs.push(dof);
+        }
+        3 * self.map[e] as usize
+    }
+
+    /// Element dof of local dof `i`.
+    fn dof(&self, i: usize) -> usize {
+        self.dofs[i / 3] + i % 3
+    }
+
+    fn len(&self) -> usize {
+        3 * self.dofs.len()
+    }
+
+    fn clear(&mut self) {
+        for &d in &self.dofs {
+            self.map[d / 3] = u32::MAX;
+        }
+        self.dofs.clear();
+    }
+}
+
 /// The element's working storage, kept per thread between calls: it is sized to
 /// the element (`m` dofs) at each call without allocating once it has grown to the
 /// largest element.
 #[derive(Default)]
 struct Work {
     rows: Rows,
+    local: Local,
     /// G = Σ c ∂g and V = Σ c ∂̃g.
     big_g: Vec<f64>,
     big_v: Vec<f64>,
     /// H = Σ c ∂(∂̃g), row-major m × m.
     h: Vec<f64>,
-    /// Element dof of each trace basis node; of the friction foot point's nodes.
+    /// One face's share of G, V (local dofs) and H (local, row stride m).
+    face_g: Vec<f64>,
+    face_v: Vec<f64>,
+    face_h: Vec<f64>,
+    /// Local dof of each master basis node at a point; of each trace basis node.
+    sp_at: Vec<usize>,
     f_at: Vec<usize>,
+    /// Element dof of the friction foot point's nodes.
     idx: Vec<usize>,
     /// The node-to-surface tangential element (residual, tangent, ∂r_T/∂t_N).
     rt: DVector<f64>,
@@ -75,9 +124,14 @@ impl Work {
         for v in [grad, vgrad].into_iter().chain(t.iter_mut()).chain(na.iter_mut()).chain(dxi.iter_mut()).chain(dn.iter_mut()).chain(dzeta.iter_mut()).chain(tf.iter_mut()).chain(nf.iter_mut()) {
             zero(v, m);
         }
-        zero(&mut self.big_g, m);
-        zero(&mut self.big_v, m);
+        for v in [&mut self.big_g, &mut self.big_v, &mut self.face_g, &mut self.face_v] {
+            zero(v, m);
+        }
         zero(&mut self.h, m * m);
+        zero(&mut self.face_h, m * m);
+        self.local.dofs.clear();
+        self.local.map.clear();
+        self.local.map.resize(m / 3, u32::MAX);
     }
 }
 
@@ -85,14 +139,13 @@ thread_local! {
     static WORK: RefCell<Work> = RefCell::new(Work::default());
 }
 
-/// Δξ̄^α = D^{αβ} (T_β − g N_β) for a surface point (rows over the element's dofs).
-fn foot_variation(sp: &SurfacePoint, g: f64, t: &[Vec<f64>; 2], na: &[Vec<f64>; 2], out: &mut [Vec<f64>; 2]) -> Result<(), ContactElementError> {
-    let d = (sp.a_ab - sp.b_ab * g).try_inverse().ok_or(ContactElementError::FocalPoint { g_n: g })?;
+/// Δξ̄^α = D^{αβ} (T_β − g N_β) for a surface point (rows over the first `d` dofs).
+fn foot_variation(sp: &SurfacePoint, g: f64, t: &[Vec<f64>; 2], na: &[Vec<f64>; 2], out: &mut [Vec<f64>; 2], d: usize) -> Result<(), ContactElementError> {
+    let inv = (sp.a_ab - sp.b_ab * g).try_inverse().ok_or(ContactElementError::FocalPoint { g_n: g })?;
     for al in 0..2 {
-        for j in 0..out[al].len() {
-            let w0 = t[0][j] - g * na[0][j];
-            let w1 = t[1][j] - g * na[1][j];
-            out[al][j] = d[(al, 0)] * w0 + d[(al, 1)] * w1;
+        let (d0, d1) = (inv[(al, 0)], inv[(al, 1)]);
+        for (((o, t0), t1), (n0, n1)) in out[al][..d].iter_mut().zip(&t[0][..d]).zip(&t[1][..d]).zip(na[0][..d].iter().zip(&na[1][..d])) {
+            *o = d0 * (t0 - g * n0) + d1 * (t1 - g * n1);
         }
     }
     Ok(())
@@ -133,30 +186,40 @@ fn element_in(work: &mut Work, mortar: &Mortar, s: usize, geometry: &Projector, 
     // the master's own basis carries the forces: facets, or `transfer: surface`
     let own_basis = geometry.is_facets() || mortar.transfer == Transfer::Surface;
     work.reset(m);
-    let Work { rows, big_g, big_v, h, f_at, idx, rt, kt, dt } = work;
+    let Work { rows, local, big_g, big_v, h, face_g, face_v, face_h, sp_at, f_at, idx, rt, kt, dt } = work;
     for &f in mortar.faces_of(s) {
         let face = mortar.face(f);
         let Some(l_s) = face.iter().position(|&c| c as usize == s) else { continue };
         if mortar.points(f).is_empty() {
             continue; // no point of this face over the master: its corners need not be in the element
         }
-        let slave_at = face.map(|c| at(slaves[c as usize]));
+        // the corners are local nodes 0..4
+        for &c in &face {
+            local.of(at(slaves[c as usize]));
+        }
         let xf = face.map(|c| x_slave[c as usize]);
         for p in mortar.points(f) {
             let c = p.w * mortar.dual_shape(f, l_s, &p.n) / law.area;
             let x: Vec3 = (0..4).map(|l| xf[l] * p.n[l]).sum();
             let sp = geometry.evaluate(p.xi, p.element);
+            // the trace: the facet of the segment's cell at ζ̄
+            let spf = if own_basis { sp } else { mortar.trace().evaluate(p.zeta, p.cell) };
+            sp_at.clear();
+            sp_at.extend(sp.basis.nodes().iter().map(|&kk| local.of(at(net[kk]))));
+            f_at.clear();
+            f_at.extend(spf.basis.nodes().iter().map(|&kk| local.of(at(net[kk]))));
+            let d = local.len();
             let n = sp.n_bar;
             let g = (x - sp.x_bar).dot(&n);
             let q = sp.basis.q();
             let qa = sp.basis.q_alpha();
             let Rows { grad, vgrad, t, na, dxi, dn, dzeta, tf, nf } = &mut *rows;
             for v in [&mut *grad, &mut *vgrad].into_iter().chain(t.iter_mut()).chain(na.iter_mut()).chain(tf.iter_mut()).chain(nf.iter_mut()) {
-                v.fill(0.0);
+                v[..d].fill(0.0);
             }
             for l in 0..4 {
                 for cc in 0..3 {
-                    let i = slave_at[l] + cc;
+                    let i = 3 * l + cc;
                     grad[i] += p.n[l] * n[cc];
                     vgrad[i] += p.n[l] * n[cc];
                     for al in 0..2 {
@@ -164,8 +227,7 @@ fn element_in(work: &mut Work, mortar: &Mortar, s: usize, geometry: &Projector, 
                     }
                 }
             }
-            for (a, &kk) in sp.basis.nodes().iter().enumerate() {
-                let j = at(net[kk]);
+            for (a, &j) in sp_at.iter().enumerate() {
                 for cc in 0..3 {
                     grad[j + cc] -= q[a] * n[cc];
                     for al in 0..2 {
@@ -174,40 +236,34 @@ fn element_in(work: &mut Work, mortar: &Mortar, s: usize, geometry: &Projector, 
                     }
                 }
             }
-            foot_variation(&sp, g, t, na, dxi)?;
+            foot_variation(&sp, g, t, na, dxi, d)?;
             // Δn̄ = a^α (N_α − b̄_αβ Δξ̄^β)
             let contra = [0, 1].map(|al| sp.a_alpha[0] * sp.a_inv[(al, 0)] + sp.a_alpha[1] * sp.a_inv[(al, 1)]);
             for (cc, dn_c) in dn.iter_mut().enumerate() {
-                for j in 0..m {
-                    let mut v = 0.0;
-                    for al in 0..2 {
-                        let w = na[al][j] - sp.b_ab[(al, 0)] * dxi[0][j] - sp.b_ab[(al, 1)] * dxi[1][j];
-                        v += contra[al][cc] * w;
-                    }
-                    dn_c[j] = v;
+                let (c0, c1) = (contra[0][cc], contra[1][cc]);
+                for ((((o, na0), na1), x0), x1) in dn_c[..d].iter_mut().zip(&na[0][..d]).zip(&na[1][..d]).zip(&dxi[0][..d]).zip(&dxi[1][..d]) {
+                    let w0 = na0 - sp.b_ab[(0, 0)] * x0 - sp.b_ab[(0, 1)] * x1;
+                    let w1 = na1 - sp.b_ab[(1, 0)] * x0 - sp.b_ab[(1, 1)] * x1;
+                    *o = c0 * w0 + c1 * w1;
                 }
             }
-            // the trace: the facet of the segment's cell at ζ̄
-            let spf = if own_basis { sp } else { mortar.trace().evaluate(p.zeta, p.cell) };
             let qf = spf.basis.q();
             let qfa = spf.basis.q_alpha();
-            f_at.clear();
-            f_at.extend(spf.basis.nodes().iter().map(|&kk| at(net[kk])));
             for (a, &j) in f_at.iter().enumerate() {
                 for cc in 0..3 {
                     vgrad[j + cc] -= qf[a] * n[cc];
                 }
             }
             if own_basis {
-                dzeta[0].copy_from_slice(&dxi[0]);
-                dzeta[1].copy_from_slice(&dxi[1]);
+                dzeta[0][..d].copy_from_slice(&dxi[0][..d]);
+                dzeta[1][..d].copy_from_slice(&dxi[1][..d]);
             } else {
                 let nf_bar = spf.n_bar;
                 let gf = (x - spf.x_bar).dot(&nf_bar);
                 for l in 0..4 {
                     for cc in 0..3 {
                         for al in 0..2 {
-                            tf[al][slave_at[l] + cc] += p.n[l] * spf.a_alpha[al][cc];
+                            tf[al][3 * l + cc] += p.n[l] * spf.a_alpha[al][cc];
                         }
                     }
                 }
@@ -219,18 +275,18 @@ fn element_in(work: &mut Work, mortar: &Mortar, s: usize, geometry: &Projector, 
                         }
                     }
                 }
-                foot_variation(&spf, gf, tf, nf, dzeta)?;
+                foot_variation(&spf, gf, tf, nf, dzeta, d)?;
             }
             // accumulate ĝ's gradient, the virtual gradient and H = Σ c ∂(∂̃g)
-            for j in 0..m {
-                big_g[j] += c * grad[j];
-                big_v[j] += c * vgrad[j];
+            for (((fg, fv), gr), vg) in face_g[..d].iter_mut().zip(&mut face_v[..d]).zip(&grad[..d]).zip(&vgrad[..d]) {
+                *fg += c * gr;
+                *fv += c * vg;
             }
             for l in 0..4 {
                 for cc in 0..3 {
-                    let i = slave_at[l] + cc;
+                    let i = 3 * l + cc;
                     let w = c * p.n[l];
-                    for (hij, dn_j) in h[i * m..(i + 1) * m].iter_mut().zip(&dn[cc]) {
+                    for (hij, dn_j) in face_h[i * m..i * m + d].iter_mut().zip(&dn[cc][..d]) {
                         *hij += w * dn_j;
                     }
                 }
@@ -238,12 +294,27 @@ fn element_in(work: &mut Work, mortar: &Mortar, s: usize, geometry: &Projector, 
             for (a, &i0) in f_at.iter().enumerate() {
                 for cc in 0..3 {
                     let i = i0 + cc;
-                    for (j, hij) in h[i * m..(i + 1) * m].iter_mut().enumerate() {
-                        *hij -= c * (qf[a] * dn[cc][j] + n[cc] * (qfa[a][0] * dzeta[0][j] + qfa[a][1] * dzeta[1][j]));
+                    let (w, wn) = (c * qf[a], c * n[cc]);
+                    let (wa0, wa1) = (wn * qfa[a][0], wn * qfa[a][1]);
+                    for (((hij, dn_j), z0), z1) in face_h[i * m..i * m + d].iter_mut().zip(&dn[cc][..d]).zip(&dzeta[0][..d]).zip(&dzeta[1][..d]) {
+                        *hij -= w * dn_j + wa0 * z0 + wa1 * z1;
                     }
                 }
             }
         }
+        // the face's sums into the element's (and the face's storage back to zero)
+        let d = local.len();
+        for i in 0..d {
+            let ei = local.dof(i);
+            big_g[ei] += std::mem::take(&mut face_g[i]);
+            big_v[ei] += std::mem::take(&mut face_v[i]);
+            let row = &mut face_h[i * m..i * m + d];
+            let h_row = &mut h[ei * m..(ei + 1) * m];
+            for (j, hij) in row.iter_mut().enumerate() {
+                h_row[local.dof(j)] += std::mem::take(hij);
+            }
+        }
+        local.clear();
     }
     let a_s = law.area;
     // K = ε_N A_s V ⊗ G (+ t_s A_s H when active)
