@@ -40,15 +40,18 @@ fn run_ironing(name: &str) -> (tempfile::TempDir, Vec<(&'static str, History, Re
 /// Run `pipelines/<name>.yaml` staged in `dir`; the histories and results of its
 /// three masters.
 fn run_staged(dir: &tempfile::TempDir, name: &str) -> Vec<(&'static str, History, Results)> {
-    run_masters(dir, name, &["facet", "b3", "b4"])
+    run_masters(dir, name, &MASTERS)
 }
+
+/// The masters every 3D ironing pipeline solves (its output files' `<name>-<master>.`).
+const MASTERS: [&str; 3] = ["facet", "b3", "b4"];
 
 /// [`run_staged`] for the pipeline's `masters` (the stages and plot series of the
 /// others are dropped from it first).
 fn run_masters(dir: &tempfile::TempDir, name: &str, masters: &[&'static str]) -> Vec<(&'static str, History, Results)> {
     let path = dir.path().join(format!("pipelines/{name}.yaml"));
     let mut doc: serde_yaml::Value = serde_yaml::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
-    let kept = |file: &str| ["facet", "b3", "b4"].iter().all(|m| !file.contains(&format!("{name}-{m}.")) || masters.contains(m));
+    let kept = |file: &str| MASTERS.iter().all(|m| !file.contains(&format!("{name}-{m}.")) || masters.contains(m));
     let stages = doc.get_mut("stages").and_then(serde_yaml::Value::as_sequence_mut).unwrap();
     stages.retain(|stage| stage.get("tag").or_else(|| stage.get("solve")).and_then(|s| s.get("output")).and_then(serde_yaml::Value::as_str).is_none_or(kept));
     for panel in stages.iter_mut().filter_map(|s| s.get_mut("plot")).flat_map(|p| p.get_mut("panels").and_then(serde_yaml::Value::as_sequence_mut).unwrap().iter_mut()) {
