@@ -108,6 +108,10 @@ pub struct Mortar {
     /// The element's mesh nodes of each slave (sorted): its faces' corners and the
     /// master nodes under them.
     nodes: Vec<Vec<u32>>,
+    /// Per face, the master nodes its quadrature points reach (sorted, mesh ids):
+    /// each point's master basis, and under the trace transfer its trace cell's
+    /// corners. Found once per point; the four slaves around a face share them.
+    face_nodes: Vec<Vec<u32>>,
     /// Cells skipped because their image in a slave face was not convex.
     pub skipped_cells: usize,
     /// Through which basis the master receives the forces.
@@ -172,6 +176,7 @@ impl Mortar {
             gap: vec![f64::INFINITY; n],
             covered: vec![0.0; n],
             nodes: vec![Vec::new(); n],
+            face_nodes: vec![Vec::new(); faces.len()],
             skipped_cells: 0,
             transfer,
             far,
@@ -377,6 +382,18 @@ impl Mortar {
     /// quadrature points.
     fn gather(&mut self, geometry: &Projector, feet: Feet<'_>, areas: &[f64]) {
         let (faces, faces_of, points, net, slaves, duals, transfer, trace) = (&self.faces, &self.faces_of, &self.points, &self.net, &self.slaves, &self.duals, self.transfer, &self.trace);
+        self.face_nodes.par_iter_mut().zip(points.par_iter()).with_min_len(16).for_each(|(nodes, pts)| {
+            nodes.clear();
+            for p in pts {
+                nodes.extend(geometry.evaluate(p.xi, p.element).basis.nodes().iter().map(|&k| net[k]));
+                if transfer == Transfer::Trace {
+                    nodes.extend(trace.corners(p.cell).iter().map(|&k| net[k as usize]));
+                }
+            }
+            nodes.sort_unstable();
+            nodes.dedup();
+        });
+        let face_nodes = &self.face_nodes;
         self.gap
             .par_iter_mut()
             .zip(self.covered.par_iter_mut())
@@ -393,12 +410,9 @@ impl Mortar {
                         let c = p.w * dual_shape(&duals[f as usize], l, &p.n);
                         gw += c * p.g;
                         cw += c;
-                        nodes.extend(geometry.evaluate(p.xi, p.element).basis.nodes().iter().map(|&k| net[k]));
-                        if transfer == Transfer::Trace {
-                            nodes.extend(trace.corners(p.cell).iter().map(|&k| net[k as usize]));
-                        }
                     }
                     if !points[f as usize].is_empty() {
+                        nodes.extend_from_slice(&face_nodes[f as usize]);
                         nodes.extend(face.iter().map(|&c| slaves[c as usize]));
                     }
                 }
