@@ -28,7 +28,9 @@ use targets::TARGETS;
 #[global_allocator]
 static GUARD: guard::Guarded = guard::Guarded;
 
-/// One fuzz test at a time: the guards keep one current input.
+/// One fuzz test at a time: the guards keep one current input. The short tests are
+/// named to sort before [`fuzz_every_reader`] (libtest starts tests in name order):
+/// started after it, one would hold a test thread idle for its whole minute.
 static SERIAL: Mutex<()> = Mutex::new(());
 
 fn serial() -> std::sync::MutexGuard<'static, ()> {
@@ -38,7 +40,7 @@ fn serial() -> std::sync::MutexGuard<'static, ()> {
 /// Every seed is read as it is: a seed a reader refuses (a stale committed stage
 /// file after a format change) would make its target fuzz nothing deep.
 #[test]
-fn fuzz_seeds_are_accepted() {
+fn fuzz_accepts_every_seed() {
     let _s = serial();
     // the largest share of its live-bytes allowance a seed uses: a reader that
     // holds more than half of it on a valid file leaves mutated ones too little
