@@ -7,7 +7,8 @@
 //! replayed by [`fuzz_corpus_replays_without_a_crash`].
 //!
 //! - `cargo test --release --locked fuzz_` — what CI runs: the seeds, the corpus,
-//!   and 6 s per target (about a minute in all);
+//!   and 3 s per target (about half a minute in all: a regression check of the
+//!   readers on every run; the searching is done by the long runs below);
 //! - `SC_FUZZ_SECONDS=120 SC_FUZZ_SEED=7 cargo test --release --locked
 //!   fuzz_every_reader -- --nocapture` — longer, with another generator seed;
 //!   prints inputs per target (docs/reliability.md).
@@ -92,12 +93,12 @@ fn fuzz_corpus_replays_without_a_crash() {
     assert!(failures.is_empty(), "corpus inputs that still crash:\n{}", failures.join("\n"));
 }
 
-/// Each target for `SC_FUZZ_SECONDS` (default 6) from generator seed `SC_FUZZ_SEED`
+/// Each target for `SC_FUZZ_SECONDS` (default 3) from generator seed `SC_FUZZ_SEED`
 /// (default 27): no panic, no allocation beyond the input, no hang.
 #[test]
 fn fuzz_every_reader() {
     let _s = serial();
-    let secs: f64 = std::env::var("SC_FUZZ_SECONDS").ok().and_then(|s| s.parse().ok()).unwrap_or(6.0);
+    let secs: f64 = std::env::var("SC_FUZZ_SECONDS").ok().and_then(|s| s.parse().ok()).unwrap_or(3.0);
     let seed: u64 = std::env::var("SC_FUZZ_SEED").ok().and_then(|s| s.parse().ok()).unwrap_or(27);
     let only = std::env::var("SC_FUZZ_TARGET").ok();
     let mut crashes = Vec::new();
