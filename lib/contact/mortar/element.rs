@@ -206,8 +206,12 @@ fn element_in(work: &mut Work, mortar: &Mortar, s: usize, geometry: &Projector, 
             let spf = if own_basis { sp } else { mortar.trace().evaluate(p.zeta, p.cell) };
             sp_at.clear();
             sp_at.extend(sp.basis.nodes().iter().map(|&kk| local.of(at(net[kk]))));
-            f_at.clear();
-            f_at.extend(spf.basis.nodes().iter().map(|&kk| local.of(at(net[kk]))));
+            if own_basis {
+                f_at.clone_from(sp_at); // spf is sp
+            } else {
+                f_at.clear();
+                f_at.extend(spf.basis.nodes().iter().map(|&kk| local.of(at(net[kk]))));
+            }
             let d = local.len();
             let n = sp.n_bar;
             let g = (x - sp.x_bar).dot(&n);
