@@ -10,10 +10,12 @@
 #   for the petsc feature). Without root, a missing CalculiX is an error; a missing
 #   ParaView or PETSc skips their tests, and says so loudly (CI runs as root, so there
 #   they always run).
-# Then the Rust unit and integration tests in release mode, and the PETSc backend:
-# built with --features petsc in the same target directory (the dependencies are
-# shared; cargo keeps both builds of the crate and puts the default binaries back on
-# the next default build) and its tests run, the two-rank mpirun one included.
+# Then the Rust unit and integration tests in release mode, in ONE build: with
+# --features petsc when PETSc and MPI are there (or being installed), so the PETSc
+# backend's tests (the two-rank mpirun one included) run beside the others; the
+# default build otherwise, or with SC_TEST_DEFAULT_BUILD=1 (it also runs the two
+# tests of what a build without PETSc says). When PETSc is being installed, the
+# heavy dependencies build meanwhile, and the crate waits for PETSc's headers.
 set -euo pipefail
 cd "$(dirname "$0")"
 
@@ -38,9 +40,14 @@ if ! have_paraview; then
     fi
 fi
 petsc=1
-if ! have_petsc; then
+if [ "${SC_TEST_DEFAULT_BUILD:-0}" = 1 ]; then
+    echo "test.sh: the default build (SC_TEST_DEFAULT_BUILD=1): the PETSc backend's tests do not run" >&2
+    petsc=0
+elif ! have_petsc; then
     if as_root; then
-        apt_lines+=("libpetsc-real-dev libopenblas0-serial libopenmpi-dev openmpi-bin pkg-config")
+        # first: the crate's build waits for it (the others only for the tests)
+        apt_lines=("libpetsc-real-dev libopenblas0-serial libopenmpi-dev openmpi-bin pkg-config" "${apt_lines[@]}")
+        petsc_marker=target/test-apt.petsc-done
     else
         echo "test.sh: SKIPPING the PETSc backend's tests: PETSc and MPI are missing and we are not root (sudo apt-get install libpetsc-real-dev libopenmpi-dev openmpi-bin pkg-config)" >&2
         petsc=0
@@ -55,6 +62,8 @@ if ! have_venv; then
     { python3 -m venv .venv && .venv/bin/pip install --quiet --disable-pip-version-check gmsh meshio pyyaml vtk; } >target/test-venv.log 2>&1 &
     jobs_+=("$!:target/test-venv.log")
 fi
+petsc_marker=${petsc_marker:-}
+rm -f target/test-apt.petsc-done
 if [ ${#apt_lines[@]} -gt 0 ]; then
     echo "test.sh: installing with apt-get: ${apt_lines[*]} (log: target/test-apt.log)" >&2
     {
@@ -62,24 +71,37 @@ if [ ${#apt_lines[@]} -gt 0 ]; then
         for line in "${apt_lines[@]}"; do
             # shellcheck disable=SC2086 # each line is a list of flags and packages
             DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $line
+            case "$line" in libpetsc*) touch target/test-apt.petsc-done ;; esac
         done
     } >target/test-apt.log 2>&1 &
     jobs_+=("$!:target/test-apt.log")
 fi
-cargo test --release --locked --no-run "$@"
-for job in "${jobs_[@]}"; do
-    if ! wait "${job%%:*}"; then
-        echo "test.sh: an install failed; its log, ${job#*:}:" >&2
-        cat "${job#*:}" >&2
+# A failed install prints its log and stops the run
+wait_for() {
+    if ! wait "${1%%:*}"; then
+        echo "test.sh: an install failed; its log, ${1#*:}:" >&2
+        cat "${1#*:}" >&2
         exit 1
     fi
-done
+}
+
+features=()
+if [ "$petsc" = 1 ]; then
+    features=(--features petsc)
+    if [ -n "$petsc_marker" ]; then
+        # PETSc is being installed: build the heavy dependencies meanwhile (the same
+        # features as the crate's build, so none is built twice), then wait for it
+        cargo build --release --locked -p faer -p nalgebra -p vtkio -p metis-sys -p serde_yaml -p rayon
+        apt_job=${jobs_[-1]}
+        while [ ! -e "$petsc_marker" ] && kill -0 "${apt_job%%:*}" 2>/dev/null; do sleep 2; done
+        [ -e "$petsc_marker" ] || wait_for "$apt_job"
+    fi
+fi
+cargo test --release --locked "${features[@]}" --no-run "$@"
+for job in "${jobs_[@]}"; do wait_for "$job"; done
 
 export PATH="$PWD/.venv/bin:$PATH"
 export SC_PYTHON="$PWD/.venv/bin/python"
-cargo test --release --locked "$@"
-
-[ "$petsc" = 1 ] || exit 0
 # Open MPI refuses to run as root unless told (CI runs as root)
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
-cargo test --release --locked --features petsc petsc
+cargo test --release --locked "${features[@]}" "$@"
