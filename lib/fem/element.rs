@@ -24,29 +24,32 @@
 //! ε = sym(∇_X u), f_a = ∫_Ω σ G_a dV, K_ab = ∫ B_aᵀ c B_b dV with B of G_a, for either
 //! formulation (the formulation argument is ignored).
 //!
+//! K is built in 3×3 node blocks K_ab: at each Gauss point the upper ones (a ≤ b,
+//! with D B_b formed once per node), the lower ones by symmetry after the last point
+//! (every material here is hyperelastic, so c and ℂ have major symmetry).
+//!
 //! Everything is fixed-size and on the stack: no heap allocation.
 #![allow(non_snake_case)]
 
 use super::hex8::{jacobian_matrix, reference_gradients, shape_derivatives, ShapeGradients};
 use super::kinematics::deformation_gradient;
 use super::quadrature::{GAUSS_HEX_2X2X2, GAUSS_HEX_WEIGHTS};
-use crate::material::{pull_back_tangent, stress_to_voigt, Material, MaterialError, MaterialModel, VOIGT};
-use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
+use crate::material::{pull_back_tangent, stress_to_voigt, Material, MaterialError, MaterialModel, Tangent, VOIGT};
+use nalgebra::{Matrix3, SMatrix, SVector, Vector3, Vector6};
 
 /// Element vector, node-major dofs.
 pub type ElementVector = SVector<f64, 24>;
 /// Element matrix, node-major dofs.
 pub type ElementMatrix = SMatrix<f64, 24, 24>;
-/// Strain–displacement operator (6 Voigt rows, 24 dofs).
-pub type BMatrix = SMatrix<f64, 6, 24>;
 
 /// Configuration the balance of momentum is written in (the results are identical).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Formulation {
     /// Second Piola–Kirchhoff stress and material tangent over the reference volume.
-    #[default]
     TotalLagrangian,
-    /// Cauchy stress and spatial tangent over the current volume.
+    /// Cauchy stress and spatial tangent over the current volume: the paper's ("written
+    /// in the current configuration"), and half the tangent's arithmetic (its B is sparse).
+    #[default]
     UpdatedLagrangian,
 }
 
@@ -81,54 +84,167 @@ fn gauss_reference(X: &[Vector3<f64>; 8], q: usize) -> Result<(ShapeGradients, f
     })
 }
 
-/// Linear strain operator of the gradients `g` (rows (∇N_a)ᵀ), engineering Voigt rows.
+/// One node's columns of the strain–displacement operator: `b[m][k]` is Voigt row m
+/// (engineering shear rows) for the node's displacement component k.
+pub type NodeB = [[f64; 3]; 6];
+
+/// Linear strain operator of the gradients `g` (rows (∇N_a)ᵀ), engineering Voigt
+/// rows, one 6×3 block per node:
+/// B_a = [g_x 0 0; 0 g_y 0; 0 0 g_z; g_y g_x 0; 0 g_z g_y; g_z 0 g_x].
 #[inline]
-pub fn b_matrix_linear(g: &ShapeGradients) -> BMatrix {
-    let mut B = BMatrix::zeros();
-    for a in 0..8 {
+pub fn b_linear(g: &ShapeGradients) -> [NodeB; 8] {
+    let mut B = [[[0.0; 3]; 6]; 8];
+    for (a, b) in B.iter_mut().enumerate() {
         let (gx, gy, gz) = (g[(a, 0)], g[(a, 1)], g[(a, 2)]);
-        let c = 3 * a;
-        B[(0, c)] = gx;
-        B[(1, c + 1)] = gy;
-        B[(2, c + 2)] = gz;
-        B[(3, c)] = gy;
-        B[(3, c + 1)] = gx;
-        B[(4, c + 1)] = gz;
-        B[(4, c + 2)] = gy;
-        B[(5, c)] = gz;
-        B[(5, c + 2)] = gx;
+        *b = [[gx, 0.0, 0.0], [0.0, gy, 0.0], [0.0, 0.0, gz], [gy, gx, 0.0], [0.0, gz, gy], [gz, 0.0, gx]];
     }
     B
 }
 
-/// Green–Lagrange variation operator: row (I, J) of B0_a maps δu_a to
-/// δE_IJ = ½(F_kI G_aJ + F_kJ G_aI) δu_ak (shear rows 2δE_IJ).
+/// Green–Lagrange variation operator, one 6×3 block per node: row (I, J) of B0_a maps
+/// δu_a to δE_IJ = ½(F_kI G_aJ + F_kJ G_aI) δu_ak (shear rows 2δE_IJ).
 #[inline]
-pub fn b_matrix_green_lagrange(G: &ShapeGradients, F: &Matrix3<f64>) -> BMatrix {
-    let mut B = BMatrix::zeros();
-    for a in 0..8 {
-        for k in 0..3 {
-            for (m, &(I, J)) in VOIGT.iter().enumerate() {
-                B[(m, 3 * a + k)] = if I == J {
-                    F[(k, I)] * G[(a, I)]
-                } else {
-                    F[(k, I)] * G[(a, J)] + F[(k, J)] * G[(a, I)]
-                };
+pub fn b_green_lagrange(G: &ShapeGradients, F: &Matrix3<f64>) -> [NodeB; 8] {
+    let mut B = [[[0.0; 3]; 6]; 8];
+    for (a, b) in B.iter_mut().enumerate() {
+        for (m, &(I, J)) in VOIGT.iter().enumerate() {
+            for k in 0..3 {
+                b[m][k] = if I == J { F[(k, I)] * G[(a, I)] } else { F[(k, I)] * G[(a, J)] + F[(k, J)] * G[(a, I)] };
             }
         }
     }
     B
 }
 
-/// Adds the initial-stress term w (g_a · T g_b) δ_ik to K.
+/// r_a += w B_aᵀ s (s the Voigt stress).
 #[inline]
-fn add_geometric(k: &mut ElementMatrix, g: &ShapeGradients, T: &Matrix3<f64>, w: f64) {
-    let gT = g * T; // row a: g_aᵀ T
+fn add_force(r: &mut ElementVector, B: &[NodeB; 8], s: &Vector6<f64>, w: f64) {
+    for (a, ba) in B.iter().enumerate() {
+        for k in 0..3 {
+            let mut f = 0.0;
+            for m in 0..6 {
+                f += ba[m][k] * s[m];
+            }
+            r[3 * a + k] += w * f;
+        }
+    }
+}
+
+/// Upper node blocks (a ≤ b) of w [B_aᵀ D B_b + (g_a · T g_b) I]: the material and the
+/// initial-stress stiffness of one Gauss point. D (the Voigt tangent) has major
+/// symmetry (every material here is hyperelastic), so K_ba = K_abᵀ: the lower blocks
+/// are filled once, after the last point ([`mirror_lower_blocks`]).
+#[inline]
+fn add_stiffness(k: &mut ElementMatrix, B: &[NodeB; 8], D: &Tangent, geometric: Option<(&ShapeGradients, &Matrix3<f64>)>, w: f64) {
+    // DB_b = D B_b (6×3)
+    let mut DB = [[[0.0; 3]; 6]; 8];
+    for (db, bb) in DB.iter_mut().zip(B) {
+        for (m, dbm) in db.iter_mut().enumerate() {
+            for (n, bn) in bb.iter().enumerate() {
+                let d = D[(m, n)];
+                for kk in 0..3 {
+                    dbm[kk] += d * bn[kk];
+                }
+            }
+        }
+    }
+    // T g_b, for the initial-stress term
+    let mut Tg = [Vector3::zeros(); 8];
+    if let Some((g, T)) = geometric {
+        for (b, tg) in Tg.iter_mut().enumerate() {
+            *tg = T * g.row(b).transpose();
+        }
+    }
     for a in 0..8 {
-        for b in 0..8 {
-            let s = w * (gT.row(a) * g.row(b).transpose())[(0, 0)];
+        for b in a..8 {
+            let mut kab = [[0.0; 3]; 3];
+            for m in 0..6 {
+                for i in 0..3 {
+                    let bai = B[a][m][i];
+                    for j in 0..3 {
+                        kab[i][j] += bai * DB[b][m][j];
+                    }
+                }
+            }
+            if let Some((g, _)) = geometric {
+                let s = g[(a, 0)] * Tg[b][0] + g[(a, 1)] * Tg[b][1] + g[(a, 2)] * Tg[b][2];
+                for (i, row) in kab.iter_mut().enumerate() {
+                    row[i] += s;
+                }
+            }
+            for (i, row) in kab.iter().enumerate() {
+                for (j, v) in row.iter().enumerate() {
+                    k[(3 * a + i, 3 * b + j)] += w * v;
+                }
+            }
+        }
+    }
+}
+
+/// Voigt index of the tensor index pair (k, l): `V[k][l]`.
+const V: [[usize; 3]; 3] = [[0, 3, 5], [3, 1, 4], [5, 4, 2]];
+
+/// r_a += w σ g_a: [`add_force`] for the linear operator of `g` ([`b_linear`]), whose
+/// column k holds g_l in Voigt row (k, l).
+#[inline]
+fn add_force_spatial(r: &mut ElementVector, g: &ShapeGradients, sigma: &Matrix3<f64>, w: f64) {
+    for a in 0..8 {
+        let f = sigma * g.row(a).transpose();
+        for k in 0..3 {
+            r[3 * a + k] += w * f[k];
+        }
+    }
+}
+
+/// [`add_stiffness`] for the linear operator of `g` ([`b_linear`]), using its
+/// sparsity: (D B_b)[m][k] = Σ_l D[m][V(k, l)] g_bl and
+/// (B_aᵀ D B_b)[i][j] = Σ_l g_al (D B_b)[V(i, l)][j], a third of the dense products'
+/// work. This is the updated Lagrangian tangent (and the small-strain one).
+#[inline]
+fn add_stiffness_spatial(k: &mut ElementMatrix, g: &ShapeGradients, D: &Tangent, T: Option<&Matrix3<f64>>, w: f64) {
+    let mut gn = [[0.0; 3]; 8];
+    for (a, ga) in gn.iter_mut().enumerate() {
+        *ga = [g[(a, 0)], g[(a, 1)], g[(a, 2)]];
+    }
+    let mut DB = [[[0.0; 3]; 6]; 8];
+    for (db, gb) in DB.iter_mut().zip(&gn) {
+        for (m, dbm) in db.iter_mut().enumerate() {
+            for (kk, v) in dbm.iter_mut().enumerate() {
+                *v = D[(m, V[kk][0])] * gb[0] + D[(m, V[kk][1])] * gb[1] + D[(m, V[kk][2])] * gb[2];
+            }
+        }
+    }
+    let mut Tg = [[0.0; 3]; 8];
+    if let Some(T) = T {
+        for (tg, gb) in Tg.iter_mut().zip(&gn) {
+            for (i, v) in tg.iter_mut().enumerate() {
+                *v = T[(i, 0)] * gb[0] + T[(i, 1)] * gb[1] + T[(i, 2)] * gb[2];
+            }
+        }
+    }
+    for a in 0..8 {
+        let ga = gn[a];
+        for b in a..8 {
+            let db = &DB[b];
+            let s = ga[0] * Tg[b][0] + ga[1] * Tg[b][1] + ga[2] * Tg[b][2];
             for i in 0..3 {
-                k[(3 * a + i, 3 * b + i)] += s;
+                for j in 0..3 {
+                    let kij = ga[0] * db[V[i][0]][j] + ga[1] * db[V[i][1]][j] + ga[2] * db[V[i][2]][j] + if i == j { s } else { 0.0 };
+                    k[(3 * a + i, 3 * b + j)] += w * kij;
+                }
+            }
+        }
+    }
+}
+
+/// Fills the lower node blocks (a > b) of `k` from the upper ones: K_ab = K_baᵀ.
+fn mirror_lower_blocks(k: &mut ElementMatrix) {
+    for b in 0..8 {
+        for a in b + 1..8 {
+            for i in 0..3 {
+                for j in 0..3 {
+                    k[(3 * a + i, 3 * b + j)] = k[(3 * b + j, 3 * a + i)];
+                }
             }
         }
     }
@@ -153,14 +269,13 @@ fn integrate(
         let F = deformation_gradient(&G, u);
         let err = |e| material_error(q, e);
         if linear {
-            let B = b_matrix_linear(&G);
             if let Some(k) = k.as_deref_mut() {
                 let (sigma, c) = mat.stress_tangent(&F).map_err(err)?;
-                r.gemv_tr(w, &B, &stress_to_voigt(&sigma), 1.0);
-                k.gemm_tr(w, &B, &(c * B), 1.0);
+                add_force_spatial(r, &G, &sigma, w);
+                add_stiffness_spatial(k, &G, &c, None, w);
             } else {
                 let sigma = mat.stress(&F).map_err(err)?;
-                r.gemv_tr(w, &B, &stress_to_voigt(&sigma), 1.0);
+                add_force_spatial(r, &G, &sigma, w);
             }
             continue;
         }
@@ -179,24 +294,24 @@ fn integrate(
             Formulation::UpdatedLagrangian => {
                 let g = G * Finv;
                 let dv = w * J;
-                let B = b_matrix_linear(&g);
-                r.gemv_tr(dv, &B, &stress_to_voigt(&sigma), 1.0);
+                add_force_spatial(r, &g, &sigma, dv);
                 if let (Some(k), Some(c)) = (k.as_deref_mut(), c) {
-                    k.gemm_tr(dv, &B, &(c * B), 1.0);
-                    add_geometric(k, &g, &sigma, dv);
+                    add_stiffness_spatial(k, &g, &c, Some(&sigma), dv);
                 }
             }
             Formulation::TotalLagrangian => {
                 let S = Finv * sigma * Finv.transpose() * J;
-                let B0 = b_matrix_green_lagrange(&G, &F);
-                r.gemv_tr(w, &B0, &stress_to_voigt(&S), 1.0);
+                let B0 = b_green_lagrange(&G, &F);
+                add_force(r, &B0, &stress_to_voigt(&S), w);
                 if let (Some(k), Some(c)) = (k.as_deref_mut(), c) {
                     let C = pull_back_tangent(&c, &Finv, J);
-                    k.gemm_tr(w, &B0, &(C * B0), 1.0);
-                    add_geometric(k, &G, &S, w);
+                    add_stiffness(k, &B0, &C, Some((&G, &S)), w);
                 }
             }
         }
+    }
+    if let Some(k) = k {
+        mirror_lower_blocks(k);
     }
     Ok(())
 }
@@ -282,4 +397,32 @@ pub fn hex8_min_jacobian(X: &[Vector3<f64>; 8], u: &[Vector3<f64>; 8]) -> Result
         min = min.min(jacobian_matrix(&x, &dN).determinant() / det0);
     }
     Ok(min)
+}
+
+#[cfg(test)]
+mod sparse_operator_tests {
+    use super::*;
+
+    /// The sparse products of the linear operator ([`add_stiffness_spatial`],
+    /// [`add_force_spatial`]) equal the dense ones of [`b_linear`]'s blocks, for any
+    /// gradients, symmetric tangent and stress (to round-off: 1e-14 of the entries).
+    #[test]
+    fn sparse_products_equal_the_dense_blocks() {
+        let v = |i: usize| ((i * 7919 % 113) as f64 / 113.0 - 0.5) * 2.0;
+        let g = ShapeGradients::from_fn(|a, j| v(3 * a + j + 1));
+        let mut D = Tangent::from_fn(|m, n| v(40 + 6 * m + n));
+        D = D + D.transpose();
+        let T = Matrix3::from_fn(|i, j| v(90 + i + j));
+        let w = 0.37;
+        let (mut kd, mut ks) = (ElementMatrix::zeros(), ElementMatrix::zeros());
+        add_stiffness(&mut kd, &b_linear(&g), &D, Some((&g, &T)), w);
+        add_stiffness_spatial(&mut ks, &g, &D, Some(&T), w);
+        mirror_lower_blocks(&mut kd);
+        mirror_lower_blocks(&mut ks);
+        assert!((kd - ks).abs().max() < 1e-14 * kd.abs().max(), "{:e}", (kd - ks).abs().max());
+        let (mut rd, mut rs) = (ElementVector::zeros(), ElementVector::zeros());
+        add_force(&mut rd, &b_linear(&g), &stress_to_voigt(&T), w);
+        add_force_spatial(&mut rs, &g, &T, w);
+        assert!((rd - rs).abs().max() < 1e-14 * rd.abs().max());
+    }
 }

@@ -2,7 +2,7 @@
 //! `solve` stage), documented key by key in `docs/pipelines.md`.
 //!
 //! ```yaml
-//! formulation: total_lagrangian
+//! formulation: updated_lagrangian
 //! materials:
 //!   - {body: lower, model: neo_hookean, E: 1.0e4, nu: 0.3}
 //! constraints:
@@ -558,8 +558,10 @@ pub struct SolveSetup {
     pub contact: Vec<ContactSetup>,
 }
 
+/// The paper's (sec. 3: "written in the current configuration"), and the cheaper
+/// tangent (docs/performance.md, "The hex8 element").
 fn default_formulation() -> Formulation {
-    Formulation::TotalLagrangian
+    Formulation::UpdatedLagrangian
 }
 
 /// A setup could not be read.
