@@ -34,7 +34,7 @@
 use super::hex8::{jacobian_matrix, reference_gradients, shape_derivatives, ShapeGradients};
 use super::kinematics::deformation_gradient;
 use super::quadrature::{GAUSS_HEX_2X2X2, GAUSS_HEX_WEIGHTS};
-use crate::material::{pull_back_tangent, stress_to_voigt, Material, MaterialError, MaterialModel, Tangent, VOIGT};
+use crate::material::{pull_back_tangent, stress_to_voigt, Material, MaterialError, MaterialModel, Tangent, VOIGT, voigt_index};
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3, Vector6};
 
 /// Element vector, node-major dofs.
@@ -135,7 +135,7 @@ fn add_force(r: &mut ElementVector, B: &[NodeB; 8], s: &Vector6<f64>, w: f64) {
 /// symmetry (every material here is hyperelastic), so K_ba = K_abᵀ: the lower blocks
 /// are filled once, after the last point ([`mirror_lower_blocks`]).
 #[inline]
-fn add_stiffness(k: &mut ElementMatrix, B: &[NodeB; 8], D: &Tangent, geometric: Option<(&ShapeGradients, &Matrix3<f64>)>, w: f64) {
+fn add_stiffness(k: &mut ElementMatrix, B: &[NodeB; 8], D: &Tangent, (g, T): (&ShapeGradients, &Matrix3<f64>), w: f64) {
     // DB_b = D B_b (6×3)
     let mut DB = [[[0.0; 3]; 6]; 8];
     for (db, bb) in DB.iter_mut().zip(B) {
@@ -150,10 +150,8 @@ fn add_stiffness(k: &mut ElementMatrix, B: &[NodeB; 8], D: &Tangent, geometric: 
     }
     // T g_b, for the initial-stress term
     let mut Tg = [Vector3::zeros(); 8];
-    if let Some((g, T)) = geometric {
-        for (b, tg) in Tg.iter_mut().enumerate() {
-            *tg = T * g.row(b).transpose();
-        }
+    for (b, tg) in Tg.iter_mut().enumerate() {
+        *tg = T * g.row(b).transpose();
     }
     for a in 0..8 {
         for b in a..8 {
@@ -166,11 +164,9 @@ fn add_stiffness(k: &mut ElementMatrix, B: &[NodeB; 8], D: &Tangent, geometric: 
                     }
                 }
             }
-            if let Some((g, _)) = geometric {
-                let s = g[(a, 0)] * Tg[b][0] + g[(a, 1)] * Tg[b][1] + g[(a, 2)] * Tg[b][2];
-                for (i, row) in kab.iter_mut().enumerate() {
-                    row[i] += s;
-                }
+            let s = g[(a, 0)] * Tg[b][0] + g[(a, 1)] * Tg[b][1] + g[(a, 2)] * Tg[b][2];
+            for (i, row) in kab.iter_mut().enumerate() {
+                row[i] += s;
             }
             for (i, row) in kab.iter().enumerate() {
                 for (j, v) in row.iter().enumerate() {
@@ -181,8 +177,20 @@ fn add_stiffness(k: &mut ElementMatrix, B: &[NodeB; 8], D: &Tangent, geometric: 
     }
 }
 
-/// Voigt index of the tensor index pair (k, l): `V[k][l]`.
-const V: [[usize; 3]; 3] = [[0, 3, 5], [3, 1, 4], [5, 4, 2]];
+/// Voigt index of the tensor index pair (k, l): `V[k][l]` ([`voigt_index`] as a table).
+const V: [[usize; 3]; 3] = {
+    let mut v = [[0; 3]; 3];
+    let mut k = 0;
+    while k < 3 {
+        let mut l = 0;
+        while l < 3 {
+            v[k][l] = voigt_index(k, l);
+            l += 1;
+        }
+        k += 1;
+    }
+    v
+};
 
 /// r_a += w σ g_a: [`add_force`] for the linear operator of `g` ([`b_linear`]), whose
 /// column k holds g_l in Voigt row (k, l).
@@ -305,7 +313,7 @@ fn integrate(
                 add_force(r, &B0, &stress_to_voigt(&S), w);
                 if let (Some(k), Some(c)) = (k.as_deref_mut(), c) {
                     let C = pull_back_tangent(&c, &Finv, J);
-                    add_stiffness(k, &B0, &C, Some((&G, &S)), w);
+                    add_stiffness(k, &B0, &C, (&G, &S), w);
                 }
             }
         }
@@ -415,7 +423,7 @@ mod sparse_operator_tests {
         let T = Matrix3::from_fn(|i, j| v(90 + i + j));
         let w = 0.37;
         let (mut kd, mut ks) = (ElementMatrix::zeros(), ElementMatrix::zeros());
-        add_stiffness(&mut kd, &b_linear(&g), &D, Some((&g, &T)), w);
+        add_stiffness(&mut kd, &b_linear(&g), &D, (&g, &T), w);
         add_stiffness_spatial(&mut ks, &g, &D, Some(&T), w);
         mirror_lower_blocks(&mut kd);
         mirror_lower_blocks(&mut ks);
