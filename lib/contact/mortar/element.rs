@@ -106,6 +106,14 @@ struct Work {
     /// Local dof of each master basis node at a point; of each trace basis node.
     sp_at: Vec<usize>,
     f_at: Vec<usize>,
+    /// The transfer weights of the tangential traction (friction): per element
+    /// node, W_s = Σ c at the slave node s itself and W_k = −Σ c N^F_k at the
+    /// master's (transfer basis), and their gradients (row-major, `m / 3` rows of
+    /// `m`); one face's share of both (local nodes, row stride m).
+    big_w: Vec<f64>,
+    dw: Vec<f64>,
+    face_w: Vec<f64>,
+    face_dw: Vec<f64>,
     /// Element dof of the friction foot point's nodes.
     idx: Vec<usize>,
     /// The node-to-surface tangential element (residual, tangent, ∂r_T/∂t_N).
@@ -129,6 +137,10 @@ impl Work {
         }
         zero(&mut self.h, m * m);
         zero(&mut self.face_h, m * m);
+        zero(&mut self.big_w, m / 3);
+        zero(&mut self.face_w, m / 3);
+        zero(&mut self.dw, (m / 3) * m);
+        zero(&mut self.face_dw, (m / 3) * m);
         self.local.dofs.clear();
         self.local.map.clear();
         self.local.map.resize(m / 3, u32::MAX);
@@ -186,7 +198,8 @@ fn element_in(work: &mut Work, mortar: &Mortar, s: usize, geometry: &Projector, 
     // the master's own basis carries the forces: facets, or `transfer: surface`
     let own_basis = geometry.is_facets() || mortar.transfer == Transfer::Surface;
     work.reset(m);
-    let Work { rows, local, big_g, big_v, h, face_g, face_v, face_h, sp_at, f_at, idx, rt, kt, dt } = work;
+    let with_friction = friction.is_some();
+    let Work { rows, local, big_g, big_v, h, face_g, face_v, face_h, big_w, dw, face_w, face_dw, sp_at, f_at, idx, rt, kt, dt } = work;
     for &f in mortar.faces_of(s) {
         let face = mortar.face(f);
         let Some(l_s) = face.iter().position(|&c| c as usize == s) else { continue };
@@ -305,6 +318,19 @@ fn element_in(work: &mut Work, mortar: &Mortar, s: usize, geometry: &Projector, 
                     }
                 }
             }
+            if with_friction {
+                // the tangential traction's transfer weights: W_s += c (slave node
+                // s), W_k −= c N^F_k(ζ̄) (master), ∂W_k −= c N^F_{k,α} Δζ̄^α
+                face_w[l_s] += c;
+                for (a, &i0) in f_at.iter().enumerate() {
+                    face_w[i0 / 3] -= c * qf[a];
+                    let (wa0, wa1) = (c * qfa[a][0], c * qfa[a][1]);
+                    let row = (i0 / 3) * m;
+                    for ((o, z0), z1) in face_dw[row..row + d].iter_mut().zip(&dzeta[0][..d]).zip(&dzeta[1][..d]) {
+                        *o -= wa0 * z0 + wa1 * z1;
+                    }
+                }
+            }
         }
         // the face's sums into the element's (and the face's storage back to zero)
         let d = local.len();
@@ -316,6 +342,17 @@ fn element_in(work: &mut Work, mortar: &Mortar, s: usize, geometry: &Projector, 
             let h_row = &mut h[ei * m..(ei + 1) * m];
             for (j, hij) in row.iter_mut().enumerate() {
                 h_row[local.dof(j)] += std::mem::take(hij);
+            }
+        }
+        if with_friction {
+            for a in 0..d / 3 {
+                let e = local.dof(3 * a) / 3;
+                big_w[e] += std::mem::take(&mut face_w[a]);
+                let row = &mut face_dw[a * m..a * m + d];
+                let w_row = &mut dw[e * m..(e + 1) * m];
+                for (j, x) in row.iter_mut().enumerate() {
+                    w_row[local.dof(j)] += std::mem::take(x);
+                }
             }
         }
         local.clear();
@@ -337,17 +374,29 @@ fn element_in(work: &mut Work, mortar: &Mortar, s: usize, geometry: &Projector, 
         tangential_contact(&x_slave[s], fr.foot, t_s, law, fr.law, rt, kt, dt)?;
         idx.clear();
         idx.extend(std::iter::once(at(slaves[s])).chain(fr.foot.basis.nodes().iter().map(|&kk| at(net[kk]))));
-        for (a, &ia) in idx.iter().enumerate() {
+        // The slave node's tangential force f_T (r_T's slave rows: A_s t_Tα times
+        // the foot's contravariant base vectors) acts where its faces meet the
+        // master, as its normal force does: the slave node receives W_s f_T
+        // (W_s = Σ c, the covered share of A_s), the master nodes W_k f_T, the
+        // node's traction t_T,s Φ_s integrated against the pair's transfer basis
+        // (docs/theory/mortar.md, "Friction").
+        for e in 0..m / 3 {
+            let w = big_w[e];
+            let dw_e = &dw[e * m..(e + 1) * m];
+            if w == 0.0 && dw_e.iter().all(|&x| x == 0.0) {
+                continue;
+            }
             for ca in 0..3 {
-                let i = ia + ca;
-                r[i] += rt[3 * a + ca];
-                // ∂r_T/∂t_N ⊗ ε_N ∂ĝ_s
+                let i = 3 * e + ca;
+                let f = rt[ca];
+                r[i] += w * f;
                 for j in 0..m {
-                    k[(i, j)] += dt[3 * a + ca] * law.eps_n * big_g[j];
+                    // W ∂f_T/∂t_N ⊗ ε_N ∂ĝ_s + f_T ⊗ ∂W
+                    k[(i, j)] += w * dt[ca] * law.eps_n * big_g[j] + f * dw_e[j];
                 }
                 for (b, &ib) in idx.iter().enumerate() {
                     for cb in 0..3 {
-                        k[(i, ib + cb)] += kt[(3 * a + ca, 3 * b + cb)];
+                        k[(i, ib + cb)] += w * kt[(ca, 3 * b + cb)];
                     }
                 }
             }
