@@ -19,6 +19,10 @@
 //! t_s = min(0, λ_s + ε_N ĝ)      r = t_s A_s V      K = ε_N A_s V ⊗ G + t_s A_s H
 //! ```
 //! For a facet master ∂̃g = ∂g and H is the Hessian of g (symmetric).
+//! With friction, the node's tangential force f_T (the node-to-surface friction
+//! element's, t_s its Coulomb bound) goes to the slave node with W_s = Σ c and to
+//! master node k with W_k = −Σ c N^F_k(ζ̄), the normal force's weights:
+//! `r += W f_T`, `K += W ⊗ ∂f_T + ε_N W ∂f_T/∂t_N ⊗ G + f_T ⊗ ∂W`.
 
 use std::cell::RefCell;
 
