@@ -660,6 +660,57 @@ mod tests {
         worst
     }
 
+    /// A slave node whose faces overhang the master's edge carries friction over the
+    /// covered share of its faces only, as its normal force: in slip, the slave
+    /// side's tangential force is μ times its normal force (exactly, on a flat
+    /// master, where both act over the same covered share). The patch: 3 × 3 nodes at
+    /// spacing 0.8 over a flat 7 × 6 grid of unit cells, its centre node at x = 5.8
+    /// and its right column at 6.6, beyond the master's edge at x = 6: the centre
+    /// node's covered share is (1 + 7/16) / 2 = 0.719. Had the node kept its whole
+    /// A_s t_T (the transfer at its own foot point), the ratio would be 1 / 0.719 (1.39, measured).
+    #[test]
+    fn friction_of_an_overhanging_node_respects_coulomb_for_its_forces() {
+        let x_net: Vec<Vec3> = (0..NA * NB).map(|k| Vec3::new((k % NA) as f64, (k / NA) as f64, 0.0)).collect();
+        let net = MasterNet { nodes: (0..(NA * NB) as u32).collect(), shape: NetShape::Grid { a: NA, b: NB } };
+        for (kind, orders, transfer) in [(MasterKind::Facet, [2, 2], Transfer::Trace), (MasterKind::Bspline, [3, 3], Transfer::Trace), (MasterKind::Bspline, [3, 3], Transfer::Surface)] {
+            let pr = Projector::for_net(kind, orders, &net, &x_net).unwrap();
+            let (p0, e0) = pr.project(&Vec3::new(5.8, 2.4, 1.0), None);
+            let n = pr.evaluate(p0.xi, e0).n_bar;
+            let x_slave: Vec<Vec3> = (0..9).map(|k| Vec3::new(5.0 + 0.8 * (k % 3) as f64, 1.6 + 0.8 * (k / 3) as f64, 0.0) - n * 0.01).collect();
+            let n_net = x_net.len() as u32;
+            let slaves: Vec<u32> = (0..9).map(|s| n_net + s).collect();
+            let faces: Vec<[u32; 4]> = [[0, 1, 4, 3], [1, 2, 5, 4], [3, 4, 7, 6], [4, 5, 8, 7]].iter().map(|f: &[u32; 4]| f.map(|s| slaves[s as usize])).collect();
+            let mut x_all = x_net.clone();
+            x_all.extend(&x_slave);
+            let mut mortar = Mortar::new(&faces, &slaves, &x_all, &net, Multipliers::Standard, transfer, f64::INFINITY).unwrap().unwrap();
+            let foot: Vec<_> = x_slave.iter().map(|x| pr.project(x, None)).collect();
+            let foot_points: Vec<_> = foot.iter().map(|(p, c)| pr.evaluate(p.xi, *c)).collect();
+            let (foot, foot_cells): (Vec<_>, Vec<_>) = foot.into_iter().unzip();
+            let areas = vec![0.64; 9];
+            mortar.integrate(&pr, &x_net, &x_slave, Feet { projections: &foot, elements: &foot_cells, points: &foot_points }, &areas).unwrap();
+            let s = 4;
+            let law = NormalLaw { lambda_n: -1.0, eps_n: 50.0, area: areas[s], touch: 0.0 };
+            let xi = foot[s].xi;
+            let flaw = FrictionLaw { mu: 0.3, eps_t: 1e3, xi_n: [xi[0] - 0.02 / NA as f64, xi[1] + 0.01 / NB as f64], t_t_n: [0.05, -0.02], held_slip: None };
+            let nodes = mortar.element_nodes(s).to_vec();
+            // the slave side's force: the sum of the slave nodes' rows
+            let slave_force = |friction: Option<NodeFriction<'_>>| {
+                let (mut r, mut k) = (DVector::zeros(0), DMatrix::zeros(0, 0));
+                let st = mortar_contact(&mortar, s, &pr, &x_slave, &law, friction, &mut r, &mut k).unwrap();
+                let f: Vec3 = nodes.iter().enumerate().filter(|(_, &id)| id >= n_net).map(|(a, _)| Vec3::new(r[3 * a], r[3 * a + 1], r[3 * a + 2])).sum();
+                (f, st)
+            };
+            let (f_n, st) = slave_force(None);
+            let (f_all, _) = slave_force(Some(NodeFriction { foot: &foot_points[s], law: &flaw }));
+            let fs = crate::contact::friction::tangential_state(&x_slave[s], &foot_points[s], st.t_n, &law, &flaw).unwrap();
+            assert!(fs.slip, "{kind:?}: the node slips");
+            let cover = f_n.norm() / (st.t_n.abs() * law.area);
+            assert!(cover < 0.95, "{kind:?}: the faces overhang the master (covered share {cover})");
+            let ratio = (f_all - f_n).norm() / (flaw.mu * f_n.norm());
+            assert!((ratio - 1.0).abs() < 1e-9, "{kind:?} {transfer:?}: tangential / (μ normal) force on the slave side = {ratio} (covered share {cover})");
+        }
+    }
+
     /// One grid: facets and B-splines of orders 2–4, standard and dual multipliers,
     /// trace and surface transfer. Tolerance 1e-6 as in the node-to-surface test (FD
     /// truncation and round-off ~1e-9).
