@@ -127,7 +127,9 @@ struct Work {
 }
 
 impl Work {
-    fn reset(&mut self, m: usize) {
+    /// Sizes and zeroes the storage for an element of `m` dofs; the friction
+    /// weights only `with_friction` (they are not read otherwise).
+    fn reset(&mut self, m: usize, with_friction: bool) {
         let zero = |v: &mut Vec<f64>, n: usize| {
             v.clear();
             v.resize(n, 0.0);
@@ -141,10 +143,12 @@ impl Work {
         }
         zero(&mut self.h, m * m);
         zero(&mut self.face_h, m * m);
-        zero(&mut self.big_w, m / 3);
-        zero(&mut self.face_w, m / 3);
-        zero(&mut self.dw, (m / 3) * m);
-        zero(&mut self.face_dw, (m / 3) * m);
+        if with_friction {
+            zero(&mut self.big_w, m / 3);
+            zero(&mut self.face_w, m / 3);
+            zero(&mut self.dw, (m / 3) * m);
+            zero(&mut self.face_dw, (m / 3) * m);
+        }
         self.local.dofs.clear();
         self.local.map.clear();
         self.local.map.resize(m / 3, u32::MAX);
@@ -201,8 +205,8 @@ fn element_in(work: &mut Work, mortar: &Mortar, s: usize, geometry: &Projector, 
     let at = |node: u32| 3 * nodes.binary_search(&node).expect("element node list holds every node it couples");
     // the master's own basis carries the forces: facets, or `transfer: surface`
     let own_basis = geometry.is_facets() || mortar.transfer == Transfer::Surface;
-    work.reset(m);
     let with_friction = friction.is_some();
+    work.reset(m, with_friction);
     let Work { rows, local, big_g, big_v, h, face_g, face_v, face_h, big_w, dw, face_w, face_dw, sp_at, f_at, idx, rt, kt, dt } = work;
     for &f in mortar.faces_of(s) {
         let face = mortar.face(f);
