@@ -22,6 +22,9 @@ use splinecontact::stages::exit_code;
 ///     face set is the master, or set `allow_flipped_master: true`;
 ///   - the capture radius (0.5 h) and the penalty ε_N the solve will use (the
 ///     setup's, or the default 25 G/h);
+///   - how contact is imposed: node-to-surface, or mortar with its multipliers
+///     and transfer (`balanced`: on how many master nodes the basis is
+///     recombined), and the friction law;
 ///   - what `adjust: <distance>` in the pair's contact entry would move: slave
 ///     nodes with |g_N| ≤ distance put onto the master, stress-free, before the
 ///     first increment (Abaqus ADJUST, ANSYS ICONT).

@@ -25,7 +25,8 @@ Our programs come from target/release (or $SC_BIN_DIR).
 Options: --threads T (2), --out DIR (pipelines/out/compare/<model>), --contact
 node|surface (ccx contact type, node by default), --no-ccx (ours only, e.g. past
 ccx's memory), --linear-solver M (ours: auto, lu, gmres, cholesky...), --ordering O
-(nested_dissection, amd), --ccx-ran R (ccx's *CONTROLS FIELD R_n = C_n; default
+(nested_dissection, amd), --integration node|mortar (ours: every contact pair's
+`integration`; the pipeline's when not given), --ccx-ran R (ccx's *CONTROLS FIELD R_n = C_n; default
 the model's, else our Newton tolerance), --mpi-ranks P (ours under `mpirun -np P`, each rank
 with T/P threads; needs a build with --features petsc; the peak RSS is then the
 largest rank's), --json, --plot PNG (log-log time against dofs; needs matplotlib
@@ -107,7 +108,7 @@ def our_exe(name):
     return str(exe)
 
 
-def level_pipeline(spec, msh, level_dir, name, linear_solver):
+def level_pipeline(spec, msh, level_dir, name, linear_solver, integration=None):
     """The model's pipeline rewritten for this mesh and folder; (path, setup path)."""
     pipe = deck.load_yaml((ROOT / spec["pipeline"]).read_text())
     stages = []
@@ -126,6 +127,8 @@ def level_pipeline(spec, msh, level_dir, name, linear_solver):
             setup = dict(body["setup"])
             if linear_solver:
                 setup["linear_solver"] = linear_solver
+            if integration:
+                setup["contact"] = [dict(c, integration=integration) for c in setup["contact"]]
             body = dict(input=name + ".sccontact", output=name + ".scres", setup=setup)
         elif kind == "export":
             continue
@@ -193,7 +196,7 @@ def run_level(model, spec, n, a, out_root):
     params = [x for k, v in spec["params"](n).items() for x in ("-setnumber", k, str(v))]
     subprocess.run([gmsh_exe(), str(ROOT / spec["geo"]), "-3", "-format", "msh41", "-bin", *params, "-o", str(msh)],
                    check=True, capture_output=True)
-    pipeline, setup_path, stages = level_pipeline(spec, msh, level_dir, name, a.linear_solver_setup)
+    pipeline, setup_path, stages = level_pipeline(spec, msh, level_dir, name, a.linear_solver_setup, a.integration)
     row = dict(model=model, level=n, params=spec["params"](n), threads=a.threads, mpi_ranks=a.mpi_ranks)
     # import + tag (not timed)
     prep = [st for st in stages if next(iter(st)) in ("import", "tag")]
@@ -290,6 +293,7 @@ def main(argv=None):
     ap.add_argument("--no-ccx", action="store_true")
     ap.add_argument("--linear-solver", default=None)
     ap.add_argument("--ordering", default=None)
+    ap.add_argument("--integration", choices=["node", "mortar"], default=None)
     ap.add_argument("--mpi-ranks", type=int, default=1)
     ap.add_argument("--ccx", default=shutil.which("ccx") or "/usr/bin/ccx")
     ap.add_argument("--ccx-ran", type=float, default=None)

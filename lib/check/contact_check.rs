@@ -9,6 +9,7 @@ use nalgebra::Vector3;
 use super::orientation::{behind, interior_points, master_cells_inward, Orientation};
 use crate::contact::adjust::PairAdjustment;
 use crate::contact::pair::{PairError, PairSolver};
+use crate::contact::settings::PairSettings;
 use crate::format::setup::Enforcement;
 use crate::mesh::Mesh;
 use crate::solver::problem::ContactDefinition;
@@ -164,6 +165,13 @@ pub struct PairCheck {
     pub allow_flipped_master: bool,
     /// The setup's adjust of this pair (None: off).
     pub adjustment: Option<PairAdjustment>,
+    /// The pair's settings as the solve resolves them (integration, friction).
+    pub settings: PairSettings,
+    /// Mortar: the slave faces integrated.
+    pub slave_faces: usize,
+    /// `transfer: balanced`: master nodes where the basis is recombined, of how many,
+    /// and max |M q − f| / max f (`contact::mortar::balance`).
+    pub balance: Option<(usize, usize, f64)>,
 }
 
 fn range(v: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
@@ -329,5 +337,8 @@ pub fn check_pair(mesh: &Mesh, def: &ContactDefinition, X_solve: &[V3], adjustme
         orientation,
         allow_flipped_master: def.allow_flipped_master,
         adjustment: adjustment.cloned(),
+        settings: def.settings,
+        slave_faces: solver.mortar().map_or(0, |m| m.n_faces()),
+        balance: solver.mortar().and_then(|m| m.balance()).map(|b| (b.region, pair.net.nodes.len(), b.defect)),
     })
 }

@@ -126,6 +126,12 @@ impl CheckReport {
                     p.name, o.behind, o.voters, o.cells_inward, o.cells
                 ));
             }
+            if let Some((_, _, defect)) = p.balance.filter(|b| b.2.is_nan() || b.2 > 1e-8) {
+                w.push(format!(
+                    "contact pair '{}': transfer: balanced could not recombine the master's basis to its faces' forces (M q − f: {defect:.1e} of max f); a uniform pressure will not give the faces' consistent forces",
+                    p.name
+                ));
+            }
             let (inside, _, failed) = p.counts();
             if failed > 0 {
                 let why: Vec<String> = p.failures().iter().map(|(r, n)| format!("{n}: {}", r.explain())).collect();

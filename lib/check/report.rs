@@ -8,7 +8,7 @@ use std::path::Path;
 
 use super::contact_check::{PairCheck, Projected};
 use super::{CheckReport, VERSION};
-use crate::format::setup::Enforcement;
+use crate::format::setup::{Enforcement, Integration, MortarMultipliers, MortarTransfer};
 use crate::format::stage::{write_atomic, write_atomic_with, StageError};
 use crate::format::vtk::{CellKind, Field, FieldValues, Grid, VtkError};
 
@@ -67,6 +67,7 @@ fn pair_lines(p: &PairCheck, out: &mut Vec<String>) {
             Enforcement::AugmentedLagrangian => "augmented Lagrangian",
         }
     ));
+    out.push(format!("  integration           {}", integration_text(p)));
     match &p.adjustment {
         None => out.push("  adjust                off".into()),
         Some(a) => {
@@ -81,6 +82,30 @@ fn pair_lines(p: &PairCheck, out: &mut Vec<String>) {
             }
         }
     }
+}
+
+/// How the pair imposes contact: the integration, with mortar its multipliers and
+/// transfer (balanced: where M recombines the basis), and the friction law.
+fn integration_text(p: &PairCheck) -> String {
+    let s = &p.settings;
+    let how = match s.integration {
+        Integration::Node => "node-to-surface (the paper's)".to_string(),
+        Integration::Mortar => {
+            let transfer = match (s.transfer, p.balance) {
+                (MortarTransfer::Trace, _) => "trace (the master's faces)".to_string(),
+                (MortarTransfer::Surface, _) => "surface (the master surface's basis)".to_string(),
+                (MortarTransfer::Balanced, Some((region, n, defect))) => format!("balanced (the surface's basis recombined on {region} of {n} master nodes; M q − f: {defect:.1e} of max f)"),
+                (MortarTransfer::Balanced, None) => "balanced (a facet master: its basis is its faces')".to_string(),
+            };
+            let mult = match s.multipliers {
+                MortarMultipliers::Standard => "standard",
+                MortarMultipliers::Dual => "dual",
+            };
+            format!("mortar over {} slave faces, {mult} multipliers, transfer {transfer}", p.slave_faces)
+        }
+    };
+    let friction = if s.frictional() { format!("Coulomb μ = {}, ε_T = {:.4e}", s.mu, s.eps_t) } else { "frictionless".to_string() };
+    format!("{how}; {friction}")
 }
 
 /// The readable summary, one line per entry.

@@ -62,6 +62,11 @@ pub enum MortarTransfer {
     /// gap, a symmetric tangent and smoother force histories in sliding; the patch
     /// test is exact only with facets.
     Surface,
+    /// The master surface's basis recombined near its edges so that a uniform
+    /// pressure gives the faces' consistent nodal forces (`contact::mortar::balance`):
+    /// as smooth in sliding as `surface`, the patch test to the quadrature of the
+    /// smooth basis.
+    Balanced,
 }
 
 /// Settings of a pair, resolved (absolute lengths).

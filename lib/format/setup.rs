@@ -451,7 +451,7 @@ pub struct ContactSetup {
     /// Mortar integration: the multiplier basis, `standard` (default) or `dual`.
     #[serde(default, skip_serializing_if = "is_standard")]
     pub multipliers: MortarMultipliers,
-    /// Mortar integration: `trace` (default) or `surface`.
+    /// Mortar integration: `trace` (default), `surface` or `balanced`.
     #[serde(default, skip_serializing_if = "is_trace")]
     pub transfer: MortarTransfer,
     /// Largest accepted penetration −g_N (a length), augmented Lagrangian only.

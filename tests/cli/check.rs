@@ -319,6 +319,7 @@ fn parisch_pipeline_checks_clean() {
         "master normal         faces the slave body: 0 of 9 slave nodes on the master see it from behind; 0 of 9 master faces point into the master body",
         "capture radius        5.0000e0 (0.5 h; h = 1.0000e1",
         "penalty ε_N           1e5 (setup), penalty",
+        "integration           node-to-surface (the paper's); frictionless",
         "upper: 18 nodes, 5 constrained dofs, centroid (0.0000e0, 0.0000e0, 1.6000e1): FREE: translation z (contact: contact)",
         "result: 0 errors, 1 warnings",
     ] {
@@ -450,3 +451,26 @@ fn a_restarted_damped_run_counts_its_work_from_the_restart() {
     assert_eq!(this, all, "the work counts from the restart:\n{err}");
 }
 
+
+/// The check says how a mortar pair imposes contact: its multipliers and transfer,
+/// and for `transfer: balanced` where the basis is recombined and how well (the
+/// Parisch model's pair under mortar; its 4 × 4 net of order 3 lies wholly in the
+/// band along the edges, and M q = f holds to round-off).
+#[test]
+fn check_names_the_mortar_transfer() {
+    let dir = crate::common::staged_pipeline("parisch", &["parisch.msh"]);
+    let yaml = std::fs::read_to_string(dir.path().join("pipelines/parisch.yaml")).unwrap();
+    let edited = yaml.replace("{pair: contact, eps_n: 1.0e5, enforcement: penalty}", "{pair: contact, eps_n: 1.0e5, enforcement: penalty, integration: mortar, transfer: balanced, mu: 0.2}");
+    assert_ne!(edited, yaml, "the Parisch pipeline's contact entry");
+    std::fs::write(dir.path().join("pipelines/parisch.yaml"), edited).unwrap();
+    let o = run("sc-pipeline", &["pipelines/parisch.yaml"], dir.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let summary = std::fs::read_to_string(dir.path().join("pipelines/out/parisch-check.txt")).unwrap();
+    let line = summary.lines().find(|l| l.trim_start().starts_with("integration")).unwrap_or_default();
+    assert!(
+        line.contains("mortar over 4 slave faces, standard multipliers, transfer balanced (the surface's basis recombined on 16 of 16 master nodes; M q − f: ") && line.ends_with("of max f); Coulomb μ = 0.2, ε_T = 1.0000e5"),
+        "{line}"
+    );
+    let defect: f64 = line.split("M q − f: ").nth(1).and_then(|t| t.split(' ').next()).and_then(|t| t.parse().ok()).unwrap();
+    assert!(defect < 1e-12, "{line}");
+}

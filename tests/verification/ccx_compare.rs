@@ -10,11 +10,18 @@ use std::process::Command;
 /// Runs `ccx_compare.py MODEL --levels LEVEL --json`; its one row, after checking
 /// that both programs finished.
 fn compare(model: &str, level: &str) -> serde_yaml::Value {
+    compare_with(model, level, &[])
+}
+
+/// The same with more options of the script (`--integration mortar`, `--contact surface`).
+fn compare_with(model: &str, level: &str, options: &[&str]) -> serde_yaml::Value {
     let out = tempfile::tempdir().unwrap();
     let bin_dir = std::path::Path::new(env!("CARGO_BIN_EXE_sc-solve")).parent().unwrap();
     let o = Command::new(python())
         .arg(repo().join("docs/scripts/ccx_compare.py"))
-        .args([model, "--levels", level, "--threads", "2", "--json", "--out"])
+        .args([model, "--levels", level, "--threads", "2", "--json"])
+        .args(options)
+        .arg("--out")
         .arg(out.path())
         .env("SC_BIN_DIR", bin_dir)
         .output()
@@ -50,6 +57,30 @@ fn crossed_beams_agree_with_calculix_at_the_smallest_level() {
     // our Newton iterations (18 measured; +25 %: a regression of the solver shows)
     let its = row["ours"]["newton_iterations"].as_u64().unwrap();
     assert!((10..=23).contains(&its), "{its} Newton iterations");
+}
+
+/// Our mortar integration against CalculiX's surface-to-surface contact, on the
+/// crossed beams at n = 4 (8,925 dofs): the two integrated contacts of the two
+/// programs. On the paper's coarse mesh our mortar's tip deflects 13.4 % more than
+/// node-to-surface's (the cantilever's reaction inside the lower beam's edge,
+/// docs/validation.md); under refinement the two integrations converge to each
+/// other (+3.1 % at n = 4, +0.9 % at n = 10), and at n = 4 ccx's surface-to-surface
+/// agrees with our mortar. Measured: max |u| 1.49426 against 1.49208 (1.5e-3), the
+/// lower beam's reaction 12133 against 12186 (4.4e-3). What differs: ccx's facet
+/// master against our B-spline, its penalty (slope 100 ε_N) against our augmented
+/// Lagrangian, its own increments and its dev/vol NEO HOOKE (the tolerances of the
+/// node-to-surface comparison above). 0.5 % and 1 % hold both; node-to-surface is
+/// 3 % from ccx's surface-to-surface here, so mixing the two pairings fails.
+#[test]
+fn crossed_beams_under_mortar_agree_with_calculix_surface_to_surface() {
+    let row = &compare_with("crossed_beams", "4", &["--integration", "mortar", "--contact", "surface"]);
+    assert_eq!(row["dofs"].as_u64(), Some(8925));
+    let (du, dr) = (f(&row["agreement"]["max_u"]), f(&row["agreement"]["reaction_z"]));
+    assert!(du < 5e-3, "max |u| differs by {du:e}");
+    assert!(dr < 1e-2, "the support reaction differs by {dr:e}");
+    // our Newton iterations (28 measured; +25 %)
+    let its = row["ours"]["newton_iterations"].as_u64().unwrap();
+    assert!((20..=35).contains(&its), "{its} Newton iterations");
 }
 
 /// The Parisch blocks at r = 6 (10,042 dofs), the first level where ccx, given our

@@ -28,6 +28,7 @@ use std::cell::RefCell;
 
 use nalgebra::{DMatrix, DVector, DVectorView};
 
+use super::balance::TransferValue;
 use super::{Mortar, Transfer};
 use crate::contact::element::zero_element;
 use crate::contact::friction::tangential_contact;
@@ -107,9 +108,14 @@ struct Work {
     face_g: Vec<f64>,
     face_v: Vec<f64>,
     face_h: Vec<f64>,
-    /// Local dof of each master basis node at a point; of each trace basis node.
+    /// Local dof of each master basis node at a point; of each transfer basis node.
     sp_at: Vec<usize>,
     f_at: Vec<usize>,
+    /// The transfer basis at a point: net node, N^F_k and N^F_{k,α} (the trace
+    /// facet's, the surface's, or the balanced T_k).
+    tb: Vec<TransferValue>,
+    tq: Vec<f64>,
+    tqa: Vec<[f64; 2]>,
     /// The transfer weights of the tangential traction (friction): per element
     /// node, W_s = Σ c at the slave node s itself and W_k = −Σ c N^F_k at the
     /// master's (transfer basis), and their gradients (row-major, `m / 3` rows of
@@ -203,11 +209,13 @@ fn element_in(work: &mut Work, mortar: &Mortar, s: usize, geometry: &Projector, 
     let net = mortar.net_nodes();
     let slaves = mortar.slave_nodes();
     let at = |node: u32| 3 * nodes.binary_search(&node).expect("element node list holds every node it couples");
-    // the master's own basis carries the forces: facets, or `transfer: surface`
-    let own_basis = geometry.is_facets() || mortar.transfer == Transfer::Surface;
+    // the master's own basis carries the forces: facets, or `transfer: surface`;
+    // `balanced` recombines it (T_k = Σ_A M_kA Q_A at the same ξ̄)
+    let own_basis = geometry.is_facets() || mortar.transfer != Transfer::Trace;
+    let balance = if geometry.is_facets() { None } else { mortar.balance() };
     let with_friction = friction.is_some();
     work.reset(m, with_friction);
-    let Work { rows, local, big_g, big_v, h, face_g, face_v, face_h, big_w, dw, face_w, face_dw, sp_at, f_at, idx, rt, kt, dt } = work;
+    let Work { rows, local, big_g, big_v, h, face_g, face_v, face_h, big_w, dw, face_w, face_dw, sp_at, f_at, tb, tq, tqa, idx, rt, kt, dt } = work;
     for &f in mortar.faces_of(s) {
         let face = mortar.face(f);
         let Some(l_s) = face.iter().position(|&c| c as usize == s) else { continue };
@@ -227,12 +235,19 @@ fn element_in(work: &mut Work, mortar: &Mortar, s: usize, geometry: &Projector, 
             let spf = if own_basis { sp } else { mortar.trace().evaluate(p.zeta, p.cell) };
             sp_at.clear();
             sp_at.extend(sp.basis.nodes().iter().map(|&kk| local.of(at(net[kk]))));
-            if own_basis {
-                f_at.clone_from(sp_at); // spf is sp
-            } else {
-                f_at.clear();
-                f_at.extend(spf.basis.nodes().iter().map(|&kk| local.of(at(net[kk]))));
+            match balance {
+                Some(b) => b.combine(&sp.basis, tb),
+                None => {
+                    tb.clear();
+                    tb.extend(spf.basis.nodes().iter().zip(spf.basis.q()).zip(spf.basis.q_alpha()).map(|((&kk, &v), &d)| (kk, v, d)));
+                }
             }
+            tq.clear();
+            tq.extend(tb.iter().map(|e| e.1));
+            tqa.clear();
+            tqa.extend(tb.iter().map(|e| e.2));
+            f_at.clear();
+            f_at.extend(tb.iter().map(|e| local.of(at(net[e.0]))));
             let d = local.len();
             let n = sp.n_bar;
             let g = (x - sp.x_bar).dot(&n);
@@ -272,8 +287,7 @@ fn element_in(work: &mut Work, mortar: &Mortar, s: usize, geometry: &Projector, 
                     *o = c0 * w0 + c1 * w1;
                 }
             }
-            let qf = spf.basis.q();
-            let qfa = spf.basis.q_alpha();
+            let (qf, qfa) = (&tq[..], &tqa[..]);
             for (a, &j) in f_at.iter().enumerate() {
                 for cc in 0..3 {
                     vgrad[j + cc] -= qf[a] * n[cc];
@@ -577,7 +591,7 @@ mod tests {
         let mut x_all: Vec<Vec3> = x_net.clone();
         x_all.extend(&x_slave);
         let mut pr = master.projector(x_net);
-        let mut mortar = Mortar::new(&faces, &slaves, &x_all, &master.net, multipliers, transfer, f64::INFINITY).unwrap().unwrap();
+        let mut mortar = Mortar::new(&faces, &slaves, &x_all, &master.net, &pr, multipliers, transfer, f64::INFINITY).unwrap().unwrap();
         let foot: Vec<_> = x_slave.iter().map(|x| pr.project(x, None)).collect();
         let foot_points: Vec<_> = foot.iter().map(|(p, c)| pr.evaluate(p.xi, *c)).collect();
         let (foot, foot_cells): (Vec<_>, Vec<_>) = foot.into_iter().unzip();
@@ -676,7 +690,7 @@ mod tests {
     fn friction_of_an_overhanging_node_respects_coulomb_for_its_forces() {
         let x_net: Vec<Vec3> = (0..NA * NB).map(|k| Vec3::new((k % NA) as f64, (k / NA) as f64, 0.0)).collect();
         let net = MasterNet { nodes: (0..(NA * NB) as u32).collect(), shape: NetShape::Grid { a: NA, b: NB } };
-        for (kind, orders, transfer) in [(MasterKind::Facet, [2, 2], Transfer::Trace), (MasterKind::Bspline, [3, 3], Transfer::Trace), (MasterKind::Bspline, [3, 3], Transfer::Surface)] {
+        for (kind, orders, transfer) in [(MasterKind::Facet, [2, 2], Transfer::Trace), (MasterKind::Bspline, [3, 3], Transfer::Trace), (MasterKind::Bspline, [3, 3], Transfer::Surface), (MasterKind::Bspline, [3, 3], Transfer::Balanced)] {
             let pr = Projector::for_net(kind, orders, &net, &x_net).unwrap();
             let (p0, e0) = pr.project(&Vec3::new(5.8, 2.4, 1.0), None);
             let n = pr.evaluate(p0.xi, e0).n_bar;
@@ -686,7 +700,7 @@ mod tests {
             let faces: Vec<[u32; 4]> = [[0, 1, 4, 3], [1, 2, 5, 4], [3, 4, 7, 6], [4, 5, 8, 7]].iter().map(|f: &[u32; 4]| f.map(|s| slaves[s as usize])).collect();
             let mut x_all = x_net.clone();
             x_all.extend(&x_slave);
-            let mut mortar = Mortar::new(&faces, &slaves, &x_all, &net, Multipliers::Standard, transfer, f64::INFINITY).unwrap().unwrap();
+            let mut mortar = Mortar::new(&faces, &slaves, &x_all, &net, &pr, Multipliers::Standard, transfer, f64::INFINITY).unwrap().unwrap();
             let foot: Vec<_> = x_slave.iter().map(|x| pr.project(x, None)).collect();
             let foot_points: Vec<_> = foot.iter().map(|(p, c)| pr.evaluate(p.xi, *c)).collect();
             let (foot, foot_cells): (Vec<_>, Vec<_>) = foot.into_iter().unzip();
@@ -729,6 +743,8 @@ mod tests {
             (3, Multipliers::Dual, Transfer::Trace),
             (3, Multipliers::Standard, Transfer::Surface),
             (4, Multipliers::Dual, Transfer::Surface),
+            (3, Multipliers::Standard, Transfer::Balanced),
+            (4, Multipliers::Dual, Transfer::Balanced),
         ] {
             check(&grid_master(order), multipliers, transfer, &LAWS);
         }
@@ -758,7 +774,7 @@ mod tests {
             let combos: &[(Multipliers, Transfer)] = match (master.kind, master.name.contains("valence")) {
                 (MasterKind::Subdivision, false) => &[(Multipliers::Standard, Transfer::Trace)],
                 (MasterKind::Subdivision, true) => &[(Multipliers::Dual, Transfer::Surface)],
-                _ => &[(Multipliers::Standard, Transfer::Trace), (Multipliers::Dual, Transfer::Surface)],
+                _ => &[(Multipliers::Standard, Transfer::Trace), (Multipliers::Dual, Transfer::Surface), (Multipliers::Standard, Transfer::Balanced)],
             };
             let laws: &[Law] = if master.kind == MasterKind::Subdivision { &SHORT } else { &LAWS };
             for &(multipliers, transfer) in combos {

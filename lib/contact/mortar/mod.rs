@@ -28,18 +28,25 @@
 //! master it is not symmetric. The integrals run over the segments of
 //! [`segment`]; the tangent takes the segmentation as fixed (a quadrature choice).
 //!
+//! `transfer: surface` takes δ̃g through the surface's own basis Q_A instead (δ̃g = δg),
+//! and `transfer: balanced` through T_k = Σ_A M_kA Q_A, the basis recombined so that
+//! a uniform pressure gives the faces' consistent forces ([`balance`]).
+//!
 //! | file        | concept |
 //! |-------------|---------|
 //! | [`trace`]   | the master body's facets: the cells that cut the slave faces |
+//! | [`balance`] | the smooth basis recombined to the faces' forces (`transfer: balanced`) |
 //! | [`segment`] | slave face ∩ master cells, triangle quadrature |
 //! | [`element`] | the weighted gap of one slave node: residual and tangent |
 
+pub mod balance;
 pub mod element;
 pub mod segment;
 pub mod trace;
 
 use rayon::prelude::*;
 
+use self::balance::Balance;
 use self::segment::{clip_convex, face_jacobian, face_point, is_convex_ccw, polygon_quadrature, quad4, signed_area2, FacePlane, P2};
 use self::trace::Trace;
 use super::master::Projector;
@@ -116,6 +123,8 @@ pub struct Mortar {
     pub skipped_cells: usize,
     /// Through which basis the master receives the forces.
     pub transfer: Transfer,
+    /// `transfer: balanced`: the recombination of the master's basis.
+    balance: Option<Balance>,
     /// A face whose corners' own foot points all lie farther than this in front of
     /// the master is not integrated (no slave node near it can be pressed; the
     /// pair passes twice its capture distance, infinity integrates every face).
@@ -137,12 +146,15 @@ pub enum MortarError {
 impl Mortar {
     /// `faces`: the slave faces as mesh node ids (cycle order); `slaves`: the pair's
     /// slave nodes (sorted); `x_ref`: reference coordinates of all mesh nodes;
-    /// `net`: the master control net (any shape); `far`: faces whose corners all lie
-    /// farther than this in front of the master are not integrated (the field `far`,
-    /// `f64::INFINITY`: every face is).
-    pub fn new(faces: &[[u32; 4]], slaves: &[u32], x_ref: &[Vec3], net: &MasterNet, multipliers: Multipliers, transfer: Transfer, far: f64) -> Result<Result<Self, MortarError>, SplineError> {
+    /// `net`: the master control net (any shape); `geometry`: the master in the
+    /// reference configuration (`transfer: balanced` integrates its basis); `far`:
+    /// faces whose corners all lie farther than this in front of the master are not
+    /// integrated (the field `far`, `f64::INFINITY`: every face is).
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(faces: &[[u32; 4]], slaves: &[u32], x_ref: &[Vec3], net: &MasterNet, geometry: &Projector, multipliers: Multipliers, transfer: Transfer, far: f64) -> Result<Result<Self, MortarError>, SplineError> {
         let x_net: Vec<Vec3> = net.nodes.iter().map(|&n| x_ref[n as usize]).collect();
         let trace = Trace::new(net, &x_net)?;
+        let balance = (transfer == Transfer::Balanced).then(|| Balance::new(geometry, &trace, &x_net));
         let mut local = Vec::with_capacity(faces.len());
         let mut faces_of = vec![Vec::new(); slaves.len()];
         for (f, nodes) in faces.iter().enumerate() {
@@ -179,6 +191,7 @@ impl Mortar {
             face_nodes: vec![Vec::new(); faces.len()],
             skipped_cells: 0,
             transfer,
+            balance,
             far,
             net: net.nodes.clone(),
             slaves: slaves.to_vec(),
@@ -201,6 +214,11 @@ impl Mortar {
         self.faces[f as usize]
     }
 
+    /// Number of slave faces.
+    pub fn n_faces(&self) -> usize {
+        self.faces.len()
+    }
+
     /// The quadrature points of face `f` at the last integration.
     pub fn points(&self, f: u32) -> &[MortarPoint] {
         &self.points[f as usize]
@@ -219,6 +237,12 @@ impl Mortar {
     /// The trace facets at the current configuration.
     pub fn trace(&self) -> &Trace {
         &self.trace
+    }
+
+    /// `transfer: balanced`: the recombination of the master's basis (`None` under
+    /// the other transfers).
+    pub fn balance(&self) -> Option<&Balance> {
+        self.balance.as_ref()
     }
 
     /// The mesh nodes of slave `s`'s element (sorted; empty when no point of its
@@ -381,13 +405,18 @@ impl Mortar {
     /// ĝ_s, the covered area and the element's nodes of every slave from the
     /// quadrature points.
     fn gather(&mut self, geometry: &Projector, feet: Feet<'_>, areas: &[f64]) {
-        let (faces, faces_of, points, net, slaves, duals, transfer, trace) = (&self.faces, &self.faces_of, &self.points, &self.net, &self.slaves, &self.duals, self.transfer, &self.trace);
+        let (faces, faces_of, points, net, slaves, duals, transfer, trace, balance) = (&self.faces, &self.faces_of, &self.points, &self.net, &self.slaves, &self.duals, self.transfer, &self.trace, self.balance.as_ref());
         self.face_nodes.par_iter_mut().zip(points.par_iter()).with_min_len(16).for_each(|(nodes, pts)| {
             nodes.clear();
             for p in pts {
-                nodes.extend(geometry.evaluate(p.xi, p.element).basis.nodes().iter().map(|&k| net[k]));
+                let basis = geometry.evaluate(p.xi, p.element).basis;
+                nodes.extend(basis.nodes().iter().map(|&k| net[k]));
                 if transfer == Transfer::Trace {
                     nodes.extend(trace.corners(p.cell).iter().map(|&k| net[k as usize]));
+                }
+                if let Some(b) = balance {
+                    // the nodes that take a share of each basis function (M's columns)
+                    nodes.extend(basis.nodes().iter().flat_map(|&a| b.column(a).iter().map(|&(k, _)| net[k as usize])));
                 }
             }
             nodes.sort_unstable();
@@ -588,7 +617,7 @@ mod tests {
         let (projections, elements): (Vec<_>, Vec<_>) = feet.into_iter().unzip();
         let feet = Feet { projections: &projections, elements: &elements, points: &points };
         let areas = vec![1.0; 9];
-        let mut fresh = Mortar::new(&faces, &slaves, &x_all, &net, Multipliers::Standard, Transfer::Trace, f64::INFINITY).unwrap().unwrap();
+        let mut fresh = Mortar::new(&faces, &slaves, &x_all, &net, &geometry, Multipliers::Standard, Transfer::Trace, f64::INFINITY).unwrap().unwrap();
         let mut kept = fresh.clone();
         fresh.integrate(&geometry, &x_net, &x_slave, feet, &areas).unwrap();
         // every corner starts from the other cell of its edge (cells a − 1 wide)

@@ -150,6 +150,11 @@ pub struct PairSolver {
 }
 
 impl PairSolver {
+    /// The mortar integration of an `integration: mortar` pair.
+    pub fn mortar(&self) -> Option<&Mortar> {
+        self.mortar.as_ref()
+    }
+
     /// `x_ref` are the reference coordinates of all mesh nodes.
     pub fn new(def: &ContactDefinition, x_ref: &[Vec3]) -> Result<Self, PairError> {
         let pair = &def.pair;
@@ -168,6 +173,7 @@ impl PairSolver {
                     &pair.slave_nodes,
                     x_ref,
                     &pair.net,
+                    &projector,
                     settings.multipliers,
                     settings.transfer,
                     // faces farther than twice the capture distance are not integrated (`Mortar::far`)
