@@ -162,15 +162,26 @@ fn patch_test_one_pass_deviation_is_pinned() {
 /// tolerance (the target).
 #[test]
 fn patch_test_mortar_is_exact_with_every_master() {
+    for_every_mortar_patch("", |label, _, p| {
+        assert!(p.pointwise < 1e-8 && p.total < 1e-8 && p.equilibrium < 1e-8, "{label}: pointwise {:e}, total {:e}, equilibrium {:e}", p.pointwise, p.total, p.equilibrium);
+    });
+}
+
+/// Runs the mortar patch test on every case of the mortar table (standard and dual
+/// multipliers; 3/5, 4/4, 5/3; facet and B-spline orders 2–4 where the lower mesh
+/// holds them) with `extra` added to the pair's integration, and hands each
+/// (label, B-spline order or 0, result) to `check`.
+fn for_every_mortar_patch(extra: &str, mut check: impl FnMut(&str, usize, &Patch)) {
     for multipliers in ["standard", "dual"] {
         for (nl, nu) in [(3, 5), (4, 4), (5, 3)] {
             for (kind, orders) in [(MasterKind::Facet, None), (MasterKind::Bspline, Some([2, 2])), (MasterKind::Bspline, Some([3, 3])), (MasterKind::Bspline, Some([4, 4]))] {
                 if orders.is_some_and(|o| o[0] > nl + 1) {
                     continue;
                 }
-                let p = patch_with(nl, nu, kind, orders, "penalty", &format!("mortar, multipliers: {multipliers}"));
-                eprintln!("  mortar ({multipliers}) {nl}/{nu} {kind:?} {orders:?}: pointwise {:.3e}, total {:.3e}, equilibrium {:.3e}, {} iterations", p.pointwise, p.total, p.equilibrium, p.iterations);
-                assert!(p.pointwise < 1e-8 && p.total < 1e-8 && p.equilibrium < 1e-8, "mortar ({multipliers}) {nl}/{nu} {kind:?} {orders:?}: pointwise {:e}, total {:e}, equilibrium {:e}", p.pointwise, p.total, p.equilibrium);
+                let p = patch_with(nl, nu, kind, orders, "penalty", &format!("mortar, multipliers: {multipliers}{extra}"));
+                let label = format!("mortar{extra} ({multipliers}) {nl}/{nu} {kind:?} {orders:?}");
+                eprintln!("  {label}: pointwise {:.3e}, total {:.3e}, equilibrium {:.3e}, {} iterations", p.pointwise, p.total, p.equilibrium, p.iterations);
+                check(&label, orders.map_or(0, |o| o[0]), &p);
             }
         }
     }
@@ -188,25 +199,15 @@ fn patch_test_mortar_is_exact_with_every_master() {
 #[test]
 fn patch_test_mortar_balanced_transfer_is_within_its_quadrature() {
     let mut worst = [0.0f64; 5];
-    for multipliers in ["standard", "dual"] {
-        for (nl, nu) in [(3, 5), (4, 4), (5, 3)] {
-            for (kind, orders) in [(MasterKind::Facet, None), (MasterKind::Bspline, Some([2, 2])), (MasterKind::Bspline, Some([3, 3])), (MasterKind::Bspline, Some([4, 4]))] {
-                if orders.is_some_and(|o| o[0] > nl + 1) {
-                    continue;
-                }
-                let p = patch_with(nl, nu, kind, orders, "penalty", &format!("mortar, multipliers: {multipliers}, transfer: balanced"));
-                eprintln!("  balanced ({multipliers}) {nl}/{nu} {kind:?} {orders:?}: pointwise {:.3e}, total {:.3e}, equilibrium {:.3e}, {} iterations", p.pointwise, p.total, p.equilibrium, p.iterations);
-                let order = orders.map_or(0, |o| o[0]);
-                worst[order] = worst[order].max(p.pointwise);
-                let bound = match order {
-                    3 => 4e-3,
-                    4 => 1e-4,
-                    _ => 1e-8,
-                };
-                assert!(p.pointwise < bound && p.equilibrium < 1e-8, "balanced ({multipliers}) {nl}/{nu} {kind:?} {orders:?}: pointwise {:e} (bound {bound:e}), equilibrium {:e}", p.pointwise, p.equilibrium);
-            }
-        }
-    }
+    for_every_mortar_patch(", transfer: balanced", |label, order, p| {
+        worst[order] = worst[order].max(p.pointwise);
+        let bound = match order {
+            3 => 4e-3,
+            4 => 1e-4,
+            _ => 1e-8,
+        };
+        assert!(p.pointwise < bound && p.equilibrium < 1e-8, "{label}: pointwise {:e} (bound {bound:e}), equilibrium {:e}", p.pointwise, p.equilibrium);
+    });
     eprintln!("balanced transfer, worst pointwise per order (facet = 0): {worst:?}");
 }
 
