@@ -129,8 +129,11 @@ impl Balance {
             }
         }
         let s: Vec<f64> = (0..n).map(|k| pat[k].iter().map(|&a| q[a as usize] * q[a as usize]).sum()).collect();
+        let mut big_b = vec![0.0; n];
         let apply = |beta: &[f64], out: &mut [f64]| {
-            let big_b: Vec<f64> = (0..n).map(|a| pat[a].iter().map(|&j| beta[j as usize]).sum::<f64>() * q[a] * q[a] / pat[a].len().max(1) as f64).collect();
+            for (a, bb) in big_b.iter_mut().enumerate() {
+                *bb = pat[a].iter().map(|&j| beta[j as usize]).sum::<f64>() * q[a] * q[a] / pat[a].len().max(1) as f64;
+            }
             for k in 0..n {
                 out[k] = if in_region[k] { s[k] * beta[k] - pat[k].iter().map(|&a| big_b[a as usize]).sum::<f64>() } else { 0.0 };
             }
@@ -150,7 +153,7 @@ impl Balance {
                 b[k] -= sum[p] / count[p] as f64;
             }
         }
-        let beta = conjugate_gradients(apply, &b, 1e-15);
+        let beta = conjugate_gradients(apply, &b, 1e-14);
         // the columns: M_kA = δ_kA + α_A + β_k q_A on P_A
         let mut offsets = Vec::with_capacity(n + 1);
         let mut entries = Vec::with_capacity(n);
@@ -292,8 +295,9 @@ fn pieces(pat: &[Vec<u32>], in_region: &[bool]) -> Vec<Option<usize>> {
 }
 
 /// Conjugate gradients for the symmetric positive semidefinite `apply` with a
-/// right-hand side in its range, from zero, to ‖r‖ ≤ `tol` ‖b‖ (or n + 100 steps).
-fn conjugate_gradients(apply: impl Fn(&[f64], &mut [f64]), b: &[f64], tol: f64) -> Vec<f64> {
+/// right-hand side in its range, from zero, to ‖r‖ ≤ `tol` ‖b‖, or until the
+/// residual has not fallen for 50 steps (round-off), or n + 100 steps.
+fn conjugate_gradients(mut apply: impl FnMut(&[f64], &mut [f64]), b: &[f64], tol: f64) -> Vec<f64> {
     let n = b.len();
     let dot = |x: &[f64], y: &[f64]| x.iter().zip(y).map(|(a, b)| a * b).sum::<f64>();
     let mut x = vec![0.0; n];
@@ -305,8 +309,9 @@ fn conjugate_gradients(apply: impl Fn(&[f64], &mut [f64]), b: &[f64], tol: f64) 
     if b_norm == 0.0 {
         return x;
     }
+    let (mut best, mut since) = (rr, 0);
     for _ in 0..n + 100 {
-        if rr.sqrt() <= tol * b_norm {
+        if rr.sqrt() <= tol * b_norm || since > 50 {
             break;
         }
         apply(&p, &mut ap);
@@ -322,6 +327,11 @@ fn conjugate_gradients(apply: impl Fn(&[f64], &mut [f64]), b: &[f64], tol: f64) 
         let rr_new = dot(&r, &r);
         let beta = rr_new / rr;
         rr = rr_new;
+        if rr < best {
+            (best, since) = (rr, 0);
+        } else {
+            since += 1;
+        }
         for i in 0..n {
             p[i] = r[i] + beta * p[i];
         }
