@@ -227,15 +227,31 @@ fn ironing3d_coulomb_under_mortar() {
     ironing3d_under_mortar("integration: mortar", &PINS_MORTAR);
 }
 
-/// The same with `transfer: surface` (the master's forces through the B-spline
-/// basis): smoother than node-to-surface on every master, V 0.79–0.93×, H 0.65–0.81×,
-/// in 1.03–1.18× its Newton corrections: issue 25's "large sliding is not worse" met
-/// on the 3D ironing. The facet master's surface basis is its trace, so its run is
-/// [`ironing3d_coulomb_under_mortar`]'s and is not repeated; the cubic master only
-/// (the quadratic one's row, measured once, is in the table).
+/// The same with `transfer: balanced` (the master's forces through the B-spline
+/// basis, recombined near the slab's edges so that a uniform pressure gives the
+/// faces' forces; the contact patch test to its quadrature): issue 25's "large
+/// sliding is not worse" on the 3D ironing with friction, held as the target itself
+/// (no more ripple than node-to-surface's in V and H, corrections within 30 %).
+/// Measured against node-to-surface: V 0.92×, H 0.81×, corrections 1.04×; the
+/// `transfer: surface` run of the table (V 0.93×, H 0.81×, 1.05×) within 2 %. The
+/// facet master's basis is its trace, so its run is [`ironing3d_coulomb_under_mortar`]'s
+/// and is not repeated; the cubic master only.
 #[test]
-fn ironing3d_coulomb_under_mortar_surface_transfer() {
-    ironing3d_under_mortar("integration: mortar, transfer: surface", &PINS_MORTAR_SURFACE);
+fn ironing3d_coulomb_under_mortar_balanced_transfer() {
+    let masters = ironing3d_under_mortar_of("ironing3d", "integration: mortar, transfer: balanced", &PINS_MORTAR_BALANCED);
+    sliding_is_not_worse(&masters, &PINS_COULOMB[2]);
+}
+
+/// Issue 25's "large sliding is not worse" for each of `masters` against the
+/// node-to-surface pin `node`: no more ripple in V and H, corrections within 30 %.
+fn sliding_is_not_worse(masters: &[(&'static str, History, Results)], node: &Pin) {
+    for (m, h, r) in masters {
+        assert_eq!(*m, node.master);
+        let v = oscillation(&h.s, &h.v, ELEMENT, STEADY.0, STEADY.1).unwrap().rms;
+        let (its, _) = newton_and_cutbacks(r);
+        assert!(v <= node.v_rms && h_ripple(h) <= node.h_rms, "{m}: V oscillation {v:.3e}, H ripple {:.3e} against node-to-surface {:.3e}, {:.3e}", h_ripple(h), node.v_rms, node.h_rms);
+        assert!(its as f64 <= 1.3 * node.newton as f64, "{m}: {its} Newton corrections against node-to-surface {}", node.newton);
+    }
 }
 
 /// The frictionless ironing under mortar with `transfer: surface`, the cubic master:
@@ -247,13 +263,7 @@ fn ironing3d_coulomb_under_mortar_surface_transfer() {
 #[test]
 fn ironing3d_frictionless_under_mortar_surface_transfer() {
     let masters = ironing3d_under_mortar_of("ironing3d_frictionless", "integration: mortar, transfer: surface", &PINS_MORTAR_SURFACE_FRICTIONLESS);
-    let node = &PINS_FRICTIONLESS[2];
-    for (m, h, r) in &masters {
-        let v = oscillation(&h.s, &h.v, ELEMENT, STEADY.0, STEADY.1).unwrap().rms;
-        let (its, _) = newton_and_cutbacks(r);
-        assert!(v <= node.v_rms && h_ripple(h) <= node.h_rms, "{m}: V oscillation {v:.3e}, H ripple {:.3e} against node-to-surface {:.3e}, {:.3e}", h_ripple(h), node.v_rms, node.h_rms);
-        assert!(its as f64 <= 1.3 * node.newton as f64, "{m}: {its} Newton corrections against node-to-surface {}", node.newton);
-    }
+    sliding_is_not_worse(&masters, &PINS_FRICTIONLESS[2]);
 }
 
 /// The frictional ironing with `mortar` added to its contact entry, against the
@@ -306,8 +316,8 @@ const PINS_MORTAR: [Pin; 2] = [
     Pin { master: "b4", v_rms: 3.008e-4, h_rms: 5.836e-4, newton: 299, cutbacks: 0 },
 ];
 
-/// Measured under mortar with `transfer: surface` (2026-11-27); the same margins.
-const PINS_MORTAR_SURFACE: [Pin; 1] = [Pin { master: "b4", v_rms: 1.820e-4, h_rms: 2.153e-4, newton: 304, cutbacks: 0 }];
+/// Measured under mortar with `transfer: balanced` (2026-11-27); the same margins.
+const PINS_MORTAR_BALANCED: [Pin; 1] = [Pin { master: "b4", v_rms: 1.811e-4, h_rms: 2.159e-4, newton: 302, cutbacks: 0 }];
 
 /// Measured frictionless under mortar with `transfer: surface` (2026-11-27).
 const PINS_MORTAR_SURFACE_FRICTIONLESS: [Pin; 1] = [Pin { master: "b4", v_rms: 7.379e-5, h_rms: 2.386e-4, newton: 246, cutbacks: 0 }];
