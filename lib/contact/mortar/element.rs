@@ -18,7 +18,9 @@
 //! ```text
 //! t_s = min(0, λ_s + ε_N ĝ)      r = t_s A_s V      K = ε_N A_s V ⊗ G + t_s A_s H
 //! ```
-//! For a facet master ∂̃g = ∂g and H is the Hessian of g (symmetric).
+//! For a facet master ∂̃g = ∂g and H is the Hessian of g (symmetric). With
+//! `transfer: surface` N^F, ζ̄ are Q, ξ̄; with `transfer: balanced` N^F_k is
+//! T_k = Σ_A M_kA Q_A at ξ̄ ([`super::balance`]), M a constant of the model.
 //! With friction, the node's tangential force f_T (the node-to-surface friction
 //! element's, t_s its Coulomb bound) goes to the slave node with W_s = Σ c and to
 //! master node k with W_k = −Σ c N^F_k(ζ̄), the normal force's weights:
