@@ -113,14 +113,7 @@ impl Balance {
         // edge band the two sums agree already; where the master is curved the
         // facets' area is the smooth surface's to O(h²)
         let piece = pieces(&pat, &in_region);
-        let n_pieces = piece.iter().filter_map(|p| *p).max().map_or(0, |m| m + 1);
-        let (mut sum_q, mut sum_f) = (vec![0.0; n_pieces], vec![0.0; n_pieces]);
-        for k in 0..n {
-            if let Some(p) = piece[k] {
-                sum_q[p] += q[k];
-                sum_f[p] += f[k];
-            }
-        }
+        let (sum_q, sum_f) = (per_piece(&piece, &q), per_piece(&piece, &f));
         for k in 0..n {
             if let Some(p) = piece[k] {
                 if sum_f[p] > 0.0 {
@@ -141,16 +134,10 @@ impl Balance {
         // right-hand side, without what round-off leaves of its mean on each piece
         // (L's null space: the constants on a piece)
         let mut b: Vec<f64> = (0..n).map(|k| if in_region[k] { f[k] - q[k] } else { 0.0 }).collect();
-        let (mut sum, mut count) = (vec![0.0; n_pieces], vec![0usize; n_pieces]);
+        let (sum, count) = (per_piece(&piece, &b), per_piece(&piece, &vec![1.0; n]));
         for k in 0..n {
             if let Some(p) = piece[k] {
-                sum[p] += b[k];
-                count[p] += 1;
-            }
-        }
-        for k in 0..n {
-            if let Some(p) = piece[k] {
-                b[k] -= sum[p] / count[p] as f64;
+                b[k] -= sum[p] / count[p];
             }
         }
         let beta = conjugate_gradients(apply, &b, 1e-14);
@@ -294,6 +281,17 @@ fn pieces(pat: &[Vec<u32>], in_region: &[bool]) -> Vec<Option<usize>> {
     piece
 }
 
+/// The sums of `values` over each connected piece (`piece` as [`pieces`] gives it).
+fn per_piece(piece: &[Option<usize>], values: &[f64]) -> Vec<f64> {
+    let mut sums = vec![0.0; piece.iter().filter_map(|p| *p).max().map_or(0, |m| m + 1)];
+    for (p, v) in piece.iter().zip(values) {
+        if let Some(p) = p {
+            sums[*p] += v;
+        }
+    }
+    sums
+}
+
 /// Conjugate gradients for the symmetric positive semidefinite `apply` with a
 /// right-hand side in its range, from zero, to ‖r‖ ≤ `tol` ‖b‖, or until the
 /// residual has not fallen for 50 steps (round-off), or n + 100 steps.
@@ -371,14 +369,10 @@ mod tests {
                 let bal = Balance::new(&geometry, &trace, &x_net);
                 assert!(bal.defect < 1e-11, "{name} order {order}: M q − f = {:e}", bal.defect);
                 let n = x_net.len();
-                let mut row_sum = vec![0.0; n];
                 for a in 0..n {
                     let col = bal.column(a);
                     let s: f64 = col.iter().map(|e| e.1).sum();
                     assert!((s - 1.0).abs() < 1e-13, "{name} order {order}: column {a} sums to {s}");
-                    for &(k, m) in col {
-                        row_sum[k as usize] += m;
-                    }
                 }
                 // Σ_k T_k = 1 at any point, and the values agree with M and Q
                 let sp = geometry.evaluate([0.13, 0.71], None);

@@ -116,8 +116,6 @@ struct Work {
     /// The transfer basis at a point: net node, N^F_k and N^F_{k,α} (the trace
     /// facet's, the surface's, or the balanced T_k).
     tb: Vec<TransferValue>,
-    tq: Vec<f64>,
-    tqa: Vec<[f64; 2]>,
     /// The transfer weights of the tangential traction (friction): per element
     /// node, W_s = Σ c at the slave node s itself and W_k = −Σ c N^F_k at the
     /// master's (transfer basis), and their gradients (row-major, `m / 3` rows of
@@ -217,7 +215,7 @@ fn element_in(work: &mut Work, mortar: &Mortar, s: usize, geometry: &Projector, 
     let balance = if geometry.is_facets() { None } else { mortar.balance() };
     let with_friction = friction.is_some();
     work.reset(m, with_friction);
-    let Work { rows, local, big_g, big_v, h, face_g, face_v, face_h, big_w, dw, face_w, face_dw, sp_at, f_at, tb, tq, tqa, idx, rt, kt, dt } = work;
+    let Work { rows, local, big_g, big_v, h, face_g, face_v, face_h, big_w, dw, face_w, face_dw, sp_at, f_at, tb, idx, rt, kt, dt } = work;
     for &f in mortar.faces_of(s) {
         let face = mortar.face(f);
         let Some(l_s) = face.iter().position(|&c| c as usize == s) else { continue };
@@ -244,10 +242,6 @@ fn element_in(work: &mut Work, mortar: &Mortar, s: usize, geometry: &Projector, 
                     tb.extend(spf.basis.nodes().iter().zip(spf.basis.q()).zip(spf.basis.q_alpha()).map(|((&kk, &v), &d)| (kk, v, d)));
                 }
             }
-            tq.clear();
-            tq.extend(tb.iter().map(|e| e.1));
-            tqa.clear();
-            tqa.extend(tb.iter().map(|e| e.2));
             f_at.clear();
             f_at.extend(tb.iter().map(|e| local.of(at(net[e.0]))));
             let d = local.len();
@@ -289,10 +283,9 @@ fn element_in(work: &mut Work, mortar: &Mortar, s: usize, geometry: &Projector, 
                     *o = c0 * w0 + c1 * w1;
                 }
             }
-            let (qf, qfa) = (&tq[..], &tqa[..]);
             for (a, &j) in f_at.iter().enumerate() {
                 for cc in 0..3 {
-                    vgrad[j + cc] -= qf[a] * n[cc];
+                    vgrad[j + cc] -= tb[a].1 * n[cc];
                 }
             }
             if own_basis {
@@ -311,8 +304,8 @@ fn element_in(work: &mut Work, mortar: &Mortar, s: usize, geometry: &Projector, 
                 for (a, &j) in f_at.iter().enumerate() {
                     for cc in 0..3 {
                         for al in 0..2 {
-                            tf[al][j + cc] -= qf[a] * spf.a_alpha[al][cc];
-                            nf[al][j + cc] -= qfa[a][al] * nf_bar[cc];
+                            tf[al][j + cc] -= tb[a].1 * spf.a_alpha[al][cc];
+                            nf[al][j + cc] -= tb[a].2[al] * nf_bar[cc];
                         }
                     }
                 }
@@ -335,8 +328,8 @@ fn element_in(work: &mut Work, mortar: &Mortar, s: usize, geometry: &Projector, 
             for (a, &i0) in f_at.iter().enumerate() {
                 for cc in 0..3 {
                     let i = i0 + cc;
-                    let (w, wn) = (c * qf[a], c * n[cc]);
-                    let (wa0, wa1) = (wn * qfa[a][0], wn * qfa[a][1]);
+                    let (w, wn) = (c * tb[a].1, c * n[cc]);
+                    let (wa0, wa1) = (wn * tb[a].2[0], wn * tb[a].2[1]);
                     for (((hij, dn_j), z0), z1) in face_h[i * m..i * m + d].iter_mut().zip(&dn[cc][..d]).zip(&dzeta[0][..d]).zip(&dzeta[1][..d]) {
                         *hij -= w * dn_j + wa0 * z0 + wa1 * z1;
                     }
@@ -347,8 +340,8 @@ fn element_in(work: &mut Work, mortar: &Mortar, s: usize, geometry: &Projector, 
                 // s), W_k −= c N^F_k(ζ̄) (master), ∂W_k −= c N^F_{k,α} Δζ̄^α
                 face_w[l_s] += c;
                 for (a, &i0) in f_at.iter().enumerate() {
-                    face_w[i0 / 3] -= c * qf[a];
-                    let (wa0, wa1) = (c * qfa[a][0], c * qfa[a][1]);
+                    face_w[i0 / 3] -= c * tb[a].1;
+                    let (wa0, wa1) = (c * tb[a].2[0], c * tb[a].2[1]);
                     let row = (i0 / 3) * m;
                     for ((o, z0), z1) in face_dw[row..row + d].iter_mut().zip(&dzeta[0][..d]).zip(&dzeta[1][..d]) {
                         *o -= wa0 * z0 + wa1 * z1;
