@@ -10,7 +10,6 @@ use super::orientation::{behind, interior_points, master_cells_inward, Orientati
 use crate::contact::adjust::PairAdjustment;
 use crate::contact::pair::{PairError, PairSolver};
 use crate::contact::settings::PairSettings;
-use crate::format::setup::Enforcement;
 use crate::mesh::Mesh;
 use crate::solver::problem::ContactDefinition;
 
@@ -157,15 +156,14 @@ pub struct PairCheck {
     pub h_master: f64,
     pub capture: f64,
     pub edge_tolerance: f64,
-    pub eps_n: f64,
+    /// Whether ε_N (in `settings`) is the default 25 G/h.
     pub eps_n_default: bool,
-    pub enforcement: Enforcement,
-    pub penetration_tolerance: f64,
     pub orientation: Orientation,
     pub allow_flipped_master: bool,
     /// The setup's adjust of this pair (None: off).
     pub adjustment: Option<PairAdjustment>,
-    /// The pair's settings as the solve resolves them (integration, friction).
+    /// The pair's settings as the solve resolves them (penalty, enforcement,
+    /// penetration tolerance, integration, friction).
     pub settings: PairSettings,
     /// Mortar: the slave faces integrated.
     pub slave_faces: usize,
@@ -330,10 +328,7 @@ pub fn check_pair(mesh: &Mesh, def: &ContactDefinition, X_solve: &[V3], adjustme
         h_master: def.h_master,
         capture: solver.capture(),
         edge_tolerance: solver.edge_tolerance(),
-        eps_n: def.settings.eps_n,
         eps_n_default: def.eps_n_default,
-        enforcement: def.settings.enforcement,
-        penetration_tolerance: tol,
         orientation,
         allow_flipped_master: def.allow_flipped_master,
         adjustment: adjustment.cloned(),

@@ -148,7 +148,7 @@ impl CheckReport {
                     "contact pair '{}': {} slave nodes penetrate the master by more than the tolerance {:.3e} (deepest: node {} by {:.4e}){}",
                     p.name,
                     pen.len(),
-                    p.penetration_tolerance,
+                    p.settings.penetration_tolerance,
                     worst.0,
                     worst.1,
                     if p.adjustment.is_some() { "; beyond the adjust distance" } else { "; `adjust` moves such nodes onto the master" }

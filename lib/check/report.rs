@@ -42,7 +42,7 @@ fn pair_lines(p: &PairCheck, out: &mut Vec<String>) {
     out.push(format!(
         "  beyond tolerance      {} nodes (tolerance {:.3e}){}",
         beyond.len(),
-        p.penetration_tolerance,
+        p.settings.penetration_tolerance,
         if beyond.is_empty() { String::new() } else { format!(": {}{}", tags.join(" "), if beyond.len() > 20 { " …" } else { "" }) }
     ));
     let o = &p.orientation;
@@ -60,9 +60,9 @@ fn pair_lines(p: &PairCheck, out: &mut Vec<String>) {
     out.push(format!("  capture radius        {:.4e} (0.5 h; h = {:.4e}, the master net's mean edge; edge tolerance {:.3e})", p.capture, p.h_master, p.edge_tolerance));
     out.push(format!(
         "  penalty ε_N           {:e}{}, {}",
-        p.eps_n,
+        p.settings.eps_n,
         if p.eps_n_default { " (default 25 G/h)" } else { " (setup)" },
-        match p.enforcement {
+        match p.settings.enforcement {
             Enforcement::Penalty => "penalty",
             Enforcement::AugmentedLagrangian => "augmented Lagrangian",
         }
