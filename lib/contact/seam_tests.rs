@@ -40,7 +40,7 @@ fn valley(slaves: [Vec3; 4]) -> (Vec<Vec3>, PairSolver) {
         slave_nodes: (28..32).collect(),
         net: MasterNet { nodes: (0..28).collect(), shape: NetShape::Patches(vec![floor, wall]) },
     };
-    let settings = PairSettings { eps_n: 1e3, enforcement: Enforcement::Penalty, penetration_tolerance: 1e-3, max_augmentations: 0, update_halvings: 0, uzawa_relaxation: 1.0, mu: 0.0, eps_t: 0.0, stabilization: 0.0, integration: Integration::Node, multipliers: Default::default(), transfer: Default::default() };
+    let settings = PairSettings { eps_n: 1e3, enforcement: Enforcement::Penalty, penetration_tolerance: 1e-3, max_augmentations: 0, update_halvings: 0, uzawa_relaxation: 1.0, mu: 0.0, eps_t: 0.0, stabilization: 0.0, integration: Integration::Node, multipliers: Default::default(), transfer: Default::default(), quadrature: Default::default() };
     let def = ContactDefinition { pair, settings, areas: vec![0.01; 4], slave_faces: Vec::new(), h_master: 1.0 / 3.0, eps_n_default: false, adjust: None, allow_flipped_master: false };
     let solver = PairSolver::new(&def, &x).unwrap();
     (x, solver)

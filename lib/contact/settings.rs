@@ -1,7 +1,7 @@
 //! A contact pair's settings, as plain data: how the normal constraint is enforced
 //! ([`Enforcement`], paper sec. 4), where it is imposed ([`Integration`]: at the
 //! slave nodes or mortar-integrated over the slave faces), the mortar pair's bases
-//! ([`MortarMultipliers`], [`MortarTransfer`]) and all of them resolved for one pair
+//! ([`MortarMultipliers`], [`MortarTransfer`], [`MortarQuadrature`]) and all of them resolved for one pair
 //! ([`PairSettings`]). The solve setup (`format::setup`) reads and writes them.
 
 use serde::{Deserialize, Serialize};
@@ -69,6 +69,22 @@ pub enum MortarTransfer {
     Balanced,
 }
 
+/// How a mortar pair's segments are cut and integrated (`contact::mortar::segment`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum MortarQuadrature {
+    /// Each slave face cut by the master's cells (its facets), 7 points of degree 5
+    /// per triangle: exact where the integrand is a polynomial per cell (the trace
+    /// transfer, facet masters).
+    #[default]
+    Cells,
+    /// Cut further by the smooth master's knot lines (chart edges on an atlas), 64
+    /// points of degree 14 per triangle: the smooth basis integrated to round-off on
+    /// a flat master (`transfer: balanced`: the patch test to 1e-8); many times the
+    /// points.
+    KnotSpans,
+}
+
 /// Settings of a pair, resolved (absolute lengths).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PairSettings {
@@ -94,6 +110,8 @@ pub struct PairSettings {
     pub multipliers: MortarMultipliers,
     /// Mortar: the basis the master receives the forces through.
     pub transfer: MortarTransfer,
+    /// Mortar: how the segments are cut and integrated.
+    pub quadrature: MortarQuadrature,
 }
 
 impl PairSettings {

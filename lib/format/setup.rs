@@ -19,7 +19,7 @@ use serde::{Deserialize, Serialize};
 
 // The contact settings are the contact layer's own plain data; this file reads
 // and writes them (re-exported here, where the setup's readers look for them).
-pub use crate::contact::settings::{Enforcement, Integration, MortarMultipliers, MortarTransfer, UPDATE_HALVINGS};
+pub use crate::contact::settings::{Enforcement, Integration, MortarMultipliers, MortarQuadrature, MortarTransfer, UPDATE_HALVINGS};
 
 /// Material models.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
@@ -454,6 +454,10 @@ pub struct ContactSetup {
     /// Mortar integration: `trace` (default), `surface` or `balanced`.
     #[serde(default, skip_serializing_if = "is_trace")]
     pub transfer: MortarTransfer,
+    /// Mortar integration: the segments cut by the master's `cells` (default) or
+    /// further by its `knot_spans`, with a rule of higher degree.
+    #[serde(default, skip_serializing_if = "is_cells")]
+    pub quadrature: MortarQuadrature,
     /// Largest accepted penetration −g_N (a length), augmented Lagrangian only.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub penetration_tolerance: Option<f64>,
@@ -493,6 +497,10 @@ pub struct ContactSetup {
     /// (`check::orientation`); without it such a pair is refused.
     #[serde(default, skip_serializing_if = "is_false")]
     pub allow_flipped_master: bool,
+}
+
+fn is_cells(v: &MortarQuadrature) -> bool {
+    *v == MortarQuadrature::Cells
 }
 
 fn is_trace(v: &MortarTransfer) -> bool {

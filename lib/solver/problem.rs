@@ -217,7 +217,7 @@ fn contact_definitions(mesh: &Mesh, pairs: &[ContactPair], setup: &SolveSetup, f
         };
         out.push(ContactDefinition {
             pair: pair.clone(),
-            settings: PairSettings { eps_n, enforcement: c.enforcement, penetration_tolerance, max_augmentations: c.max_augmentations, update_halvings: c.update_halvings, uzawa_relaxation: c.uzawa_relaxation, mu: c.mu, eps_t, stabilization: c.stabilization, integration: c.integration, multipliers: c.multipliers, transfer: c.transfer },
+            settings: PairSettings { eps_n, enforcement: c.enforcement, penetration_tolerance, max_augmentations: c.max_augmentations, update_halvings: c.update_halvings, uzawa_relaxation: c.uzawa_relaxation, mu: c.mu, eps_t, stabilization: c.stabilization, integration: c.integration, multipliers: c.multipliers, transfer: c.transfer, quadrature: c.quadrature },
             eps_n_default,
             areas,
             slave_faces,

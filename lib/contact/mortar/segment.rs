@@ -216,17 +216,136 @@ pub fn clip_convex(subject: &[P2], clip: &[P2], out: &mut Vec<P2>, scratch: &mut
 }
 
 /// The quadrature points (η, weight in η-area) of a polygon: a fan of triangles
-/// from its first vertex, each with [`TRIANGLE_7`] and its signed area (so a
-/// polygon that is not quite convex, a clipped segment taken back to η, is still
-/// integrated exactly for polynomials).
-pub fn polygon_quadrature(poly: &[P2], mut push: impl FnMut([f64; 2], f64)) {
+/// from its first vertex, each with the triangle `rule` ([`TRIANGLE_7`], or
+/// [`collapsed_triangle_rule`]) and its signed area (so a polygon that is not quite
+/// convex, a clipped segment taken back to η, is still integrated exactly for
+/// polynomials).
+pub fn polygon_quadrature(poly: &[P2], rule: &[([f64; 3], f64)], mut push: impl FnMut([f64; 2], f64)) {
     for i in 1..poly.len().saturating_sub(1) {
         let (a, b, c) = (poly[0], poly[i], poly[i + 1]);
         let area = 0.5 * cross(&(b - a), &(c - a));
-        for (l, w) in TRIANGLE_7 {
+        for &(l, w) in rule {
             let p = a * l[0] + b * l[1] + c * l[2];
             push([p.x, p.y], w * area);
         }
+    }
+}
+
+/// Gauss–Legendre points on [0, 1] and their weights, `n` of them (degree 2n − 1):
+/// the roots of P_n by Newton from Chebyshev guesses.
+pub fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
+    let mut out = Vec::with_capacity(n);
+    for i in 0..n {
+        let mut x = (std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
+        let mut dp = 1.0;
+        for _ in 0..100 {
+            // P_n(x) and P_n'(x) by the three-term recurrence
+            let (mut p0, mut p1) = (1.0, x);
+            for k in 2..=n {
+                let kf = k as f64;
+                (p0, p1) = (p1, ((2.0 * kf - 1.0) * x * p1 - (kf - 1.0) * p0) / kf);
+            }
+            let p = if n == 0 { 1.0 } else if n == 1 { x } else { p1 };
+            let pm = if n == 1 { 1.0 } else { p0 };
+            dp = n as f64 * (x * p - pm) / (x * x - 1.0);
+            let step = p / dp;
+            x -= step;
+            if step.abs() < 1e-16 {
+                break;
+            }
+        }
+        out.push((0.5 * (1.0 - x), 1.0 / ((1.0 - x * x) * dp * dp)));
+    }
+    out.reverse();
+    out
+}
+
+/// A triangle rule of `n × n` points: Gauss–Legendre in both directions of the
+/// square collapsed onto the triangle (Duffy), barycentric coordinates and weights
+/// summing to 1; exact for polynomials of total degree 2n − 2.
+pub fn collapsed_triangle_rule(n: usize) -> Vec<([f64; 3], f64)> {
+    let g = gauss_legendre(n);
+    let mut rule = Vec::with_capacity(n * n);
+    for &(u, wu) in &g {
+        for &(v, wv) in &g {
+            // (u, v) ∈ [0, 1]² ↦ λ₁ = u, λ₂ = (1 − u) v; area element (1 − u), the
+            // unit triangle's area ½ divided out
+            let (l1, l2) = (u, (1.0 - u) * v);
+            rule.push(([1.0 - l1 - l2, l1, l2], 2.0 * wu * wv * (1.0 - u)));
+        }
+    }
+    rule
+}
+
+/// Convex polygons in one flat list (storage reused from segment to segment): the
+/// pieces of a segment cut by the master's knot lines.
+#[derive(Debug, Default)]
+pub struct Pieces {
+    points: Vec<P2>,
+    ends: Vec<usize>,
+    // the other side of a split, swapped in
+    next_points: Vec<P2>,
+    next_ends: Vec<usize>,
+}
+
+impl Pieces {
+    /// One piece: `poly`.
+    pub fn reset(&mut self, poly: &[P2]) {
+        self.points.clear();
+        self.ends.clear();
+        self.points.extend_from_slice(poly);
+        self.ends.push(poly.len());
+    }
+
+    pub fn len(&self) -> usize {
+        self.ends.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.ends.is_empty()
+    }
+
+    /// Piece `i`, mutable (its vertices are taken back to η in place).
+    pub fn piece_mut(&mut self, i: usize) -> &mut [P2] {
+        let lo = if i == 0 { 0 } else { self.ends[i - 1] };
+        &mut self.points[lo..self.ends[i]]
+    }
+
+    /// Every piece split by the line through `a` and `b`, both sides kept; pieces
+    /// whose doubled area is below `min_a2` are dropped (a line along a piece's edge
+    /// leaves a sliver of round-off).
+    pub fn split(&mut self, a: P2, b: P2, min_a2: f64) {
+        self.next_points.clear();
+        self.next_ends.clear();
+        let mut lo = 0;
+        for &hi in &self.ends {
+            let poly = &self.points[lo..hi];
+            lo = hi;
+            for sign in [1.0, -1.0] {
+                let side = |p: &P2| sign * cross(&(b - a), &(p - a));
+                let first = self.next_points.len();
+                let m = poly.len();
+                for i in 0..m {
+                    let (p, q) = (poly[i], poly[(i + 1) % m]);
+                    let (sp, sq) = (side(&p), side(&q));
+                    if sp >= 0.0 {
+                        self.next_points.push(p);
+                    }
+                    if (sp >= 0.0) != (sq >= 0.0) {
+                        let t = sp / (sp - sq);
+                        self.next_points.push(p + (q - p) * t);
+                    }
+                }
+                let part = &self.next_points[first..];
+                if part.len() >= 3 && signed_area2(part) > min_a2 {
+                    self.next_ends.push(self.next_points.len());
+                } else {
+                    self.next_points.truncate(first);
+                }
+            }
+        }
+        std::mem::swap(&mut self.points, &mut self.next_points);
+        std::mem::swap(&mut self.ends, &mut self.next_ends);
     }
 }
 
@@ -248,6 +367,58 @@ mod tests {
     }
 
     #[test]
+    fn collapsed_rules_are_exact_to_their_degree() {
+        // Gauss–Legendre on [0, 1]: ∫ x^d = 1/(d + 1) for d ≤ 2n − 1
+        for n in 1..=10 {
+            let g = gauss_legendre(n);
+            for d in 0..2 * n as i32 {
+                let q: f64 = g.iter().map(|(x, w)| w * x.powi(d)).sum();
+                assert!((q - 1.0 / (d as f64 + 1.0)).abs() < 1e-14, "n {n}, x^{d}: {q}");
+            }
+        }
+        // the triangle: ∫_T x^a y^b = a! b! / (a + b + 2)! for a + b ≤ 2n − 2; and not
+        // beyond (the check can fail)
+        let fact = |n: u32| (1..=n).map(f64::from).product::<f64>();
+        for n in [3usize, 6] {
+            let rule = collapsed_triangle_rule(n);
+            assert_eq!(rule.len(), n * n);
+            let err = |a: u32, b: u32| {
+                let q: f64 = rule.iter().map(|(l, w)| 0.5 * w * l[1].powi(a as i32) * l[2].powi(b as i32)).sum();
+                (q - fact(a) * fact(b) / fact(a + b + 2)).abs() / (fact(a) * fact(b) / fact(a + b + 2))
+            };
+            let deg = 2 * n as u32 - 2;
+            for a in 0..=deg {
+                for b in 0..=(deg - a) {
+                    assert!(err(a, b) < 1e-13, "n {n}: x^{a} y^{b}: {:e}", err(a, b));
+                }
+            }
+            assert!((0..=deg + 2).any(|a| err(a, deg + 2 - a) > 1e-10), "n {n}: exact beyond its degree?");
+        }
+    }
+
+    #[test]
+    fn splitting_by_lines_tiles_the_polygon() {
+        let sq: Vec<P2> = [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]].iter().map(|p| P2::new(p[0], p[1])).collect();
+        let mut pieces = Pieces::default();
+        pieces.reset(&sq);
+        // two oblique lines through the square, and one along its edge (a sliver: dropped)
+        pieces.split(P2::new(-0.3, -2.0), P2::new(0.4, 2.0), 1e-14);
+        pieces.split(P2::new(-2.0, 0.25), P2::new(2.0, 0.1), 1e-14);
+        pieces.split(P2::new(1.0, -3.0), P2::new(1.0, 3.0), 1e-14);
+        assert_eq!(pieces.len(), 4);
+        let total: f64 = (0..pieces.len()).map(|i| 0.5 * signed_area2(pieces.piece_mut(i))).sum();
+        assert!((total - 4.0).abs() < 1e-14, "{total}");
+        for i in 0..pieces.len() {
+            let p = pieces.piece_mut(i).to_vec();
+            assert!(is_convex_ccw(&p), "{p:?}");
+            // every piece on one side of each line
+            let c = p.iter().sum::<P2>() / p.len() as f64;
+            let side = cross(&(P2::new(0.4, 2.0) - P2::new(-0.3, -2.0)), &(c - P2::new(-0.3, -2.0)));
+            assert!(p.iter().all(|v| cross(&(P2::new(0.4, 2.0) - P2::new(-0.3, -2.0)), &(v - P2::new(-0.3, -2.0))) * side >= -1e-15));
+        }
+    }
+
+    #[test]
     fn clipping_two_squares_gives_their_overlap() {
         let sq: Vec<P2> = [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]].iter().map(|p| P2::new(p[0], p[1])).collect();
         let shifted: Vec<P2> = sq.iter().map(|p| p * 0.75 + P2::new(0.6, -0.3)).collect();
@@ -257,7 +428,7 @@ mod tests {
         let area = 0.5 * signed_area2(&out);
         assert!((area - 1.15 * 1.45).abs() < 1e-14, "{area}");
         let mut total = 0.0;
-        polygon_quadrature(&out, |_, w| total += w);
+        polygon_quadrature(&out, &TRIANGLE_7, |_, w| total += w);
         assert!((total - area).abs() < 1e-14);
         // disjoint
         let far: Vec<P2> = sq.iter().map(|p| p + P2::new(5.0, 0.0)).collect();

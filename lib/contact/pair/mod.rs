@@ -180,7 +180,8 @@ impl PairSolver {
                     h_master,
                 )
                     .map_err(err)?
-                    .map_err(|source| PairError::Mortar { pair: pair.name.clone(), source })?,
+                    .map_err(|source| PairError::Mortar { pair: pair.name.clone(), source })?
+                    .with_quadrature(settings.quadrature),
             ),
         };
         Ok(Self {
