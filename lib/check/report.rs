@@ -8,7 +8,7 @@ use std::path::Path;
 
 use super::contact_check::{PairCheck, Projected};
 use super::{CheckReport, VERSION};
-use crate::format::setup::{Enforcement, Integration, MortarMultipliers, MortarTransfer};
+use crate::format::setup::{Enforcement, Integration, MortarMultipliers, MortarQuadrature, MortarTransfer};
 use crate::format::stage::{write_atomic, write_atomic_with, StageError};
 use crate::format::vtk::{CellKind, Field, FieldValues, Grid, VtkError};
 
@@ -101,7 +101,11 @@ fn integration_text(p: &PairCheck) -> String {
                 MortarMultipliers::Standard => "standard",
                 MortarMultipliers::Dual => "dual",
             };
-            format!("mortar over {} slave faces, {mult} multipliers, transfer {transfer}", p.slave_faces)
+            let quadrature = match s.quadrature {
+                MortarQuadrature::Cells => "",
+                MortarQuadrature::KnotSpans => ", segments cut by the knot spans (64 points per triangle)",
+            };
+            format!("mortar over {} slave faces, {mult} multipliers, transfer {transfer}{quadrature}", p.slave_faces)
         }
     };
     let friction = if s.frictional() { format!("Coulomb μ = {}, ε_T = {:.4e}", s.mu, s.eps_t) } else { "frictionless".to_string() };
