@@ -24,7 +24,8 @@ use splinecontact::stages::exit_code;
 ///     setup's, or the default 25 G/h);
 ///   - how contact is imposed: node-to-surface, or mortar with its multipliers
 ///     and transfer (`balanced`: on how many master nodes the basis is
-///     recombined), and the friction law;
+///     recombined) and quadrature (`knot_spans`: segments cut by the knot
+///     spans), and the friction law;
 ///   - what `adjust: <distance>` in the pair's contact entry would move: slave
 ///     nodes with |g_N| ≤ distance put onto the master, stress-free, before the
 ///     first increment (Abaqus ADJUST, ANSYS ICONT).

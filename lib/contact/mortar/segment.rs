@@ -32,6 +32,12 @@
 //! edges are straight in η where the cell's edges are not, a quadrature choice.
 //! Clipping in the plane, not in η, keeps the images of distant cell corners sound:
 //! the bilinear map of a skewed face, continued far beyond the face, folds over.
+//!
+//! `quadrature: knot_spans` cuts each segment further, in η, by the knot lines of a
+//! smooth master ([`Pieces`]; the lines come from `super::cut_by_spans`), and
+//! integrates the pieces by [`collapsed_triangle_rule`] (8 × 8 points): the smooth
+//! basis is one polynomial in ξ̄ per piece, analytic in x, and the rule converges
+//! exponentially (`docs/theory/mortar.md`, "The master side").
 
 use nalgebra::Vector2;
 
