@@ -452,15 +452,15 @@ fn a_restarted_damped_run_counts_its_work_from_the_restart() {
 }
 
 
-/// The check says how a mortar pair imposes contact: its multipliers and transfer,
-/// and for `transfer: balanced` where the basis is recombined and how well (the
+/// The check says how a mortar pair imposes contact: its multipliers, transfer and
+/// quadrature, and for `transfer: balanced` where the basis is recombined and how well (the
 /// Parisch model's pair under mortar; its 4 × 4 net of order 3 lies wholly in the
 /// band along the edges, and M q = f holds to round-off).
 #[test]
 fn check_names_the_mortar_transfer() {
     let dir = crate::common::staged_pipeline("parisch", &["parisch.msh"]);
     let yaml = std::fs::read_to_string(dir.path().join("pipelines/parisch.yaml")).unwrap();
-    let edited = yaml.replace("{pair: contact, eps_n: 1.0e5, enforcement: penalty}", "{pair: contact, eps_n: 1.0e5, enforcement: penalty, integration: mortar, transfer: balanced, mu: 0.2}");
+    let edited = yaml.replace("{pair: contact, eps_n: 1.0e5, enforcement: penalty}", "{pair: contact, eps_n: 1.0e5, enforcement: penalty, integration: mortar, transfer: balanced, quadrature: knot_spans, mu: 0.2}");
     assert_ne!(edited, yaml, "the Parisch pipeline's contact entry");
     std::fs::write(dir.path().join("pipelines/parisch.yaml"), edited).unwrap();
     let o = run("sc-pipeline", &["pipelines/parisch.yaml"], dir.path());
@@ -468,7 +468,8 @@ fn check_names_the_mortar_transfer() {
     let summary = std::fs::read_to_string(dir.path().join("pipelines/out/parisch-check.txt")).unwrap();
     let line = summary.lines().find(|l| l.trim_start().starts_with("integration")).unwrap_or_default();
     assert!(
-        line.contains("mortar over 4 slave faces, standard multipliers, transfer balanced (the surface's basis recombined on 16 of 16 master nodes; M q − f: ") && line.ends_with("of max f); Coulomb μ = 0.2, ε_T = 1.0000e5"),
+        line.contains("mortar over 4 slave faces, standard multipliers, transfer balanced (the surface's basis recombined on 16 of 16 master nodes; M q − f: ")
+            && line.ends_with("of max f), segments cut by the knot spans (64 points per triangle); Coulomb μ = 0.2, ε_T = 1.0000e5"),
         "{line}"
     );
     let defect: f64 = line.split("M q − f: ").nth(1).and_then(|t| t.split(' ').next()).and_then(|t| t.parse().ok()).unwrap();
