@@ -598,6 +598,7 @@ fn segment(trace: &Trace, x_net: &[Vec3], plane: &FacePlane, cell: usize, seg: &
 /// cylinder missed 5e-4 of K, so their segments keep the cells and only the rule of
 /// higher degree.
 fn cut_by_spans(geometry: &Projector, plane: &FacePlane, xf: &[Vec3; 4], start: Start, seg: &[P2], pieces: &mut Pieces) {
+    let Projector::BSpline(pr) = geometry else { return };
     // in η, where the pieces are integrated, a face square of doubled area 8
     let min_a2 = 1e-13;
     let line = |a: &SurfacePoint, b: &SurfacePoint, pieces: &mut Pieces| {
@@ -629,52 +630,42 @@ fn cut_by_spans(geometry: &Projector, plane: &FacePlane, xf: &[Vec3; 4], start: 
             }
         }
     };
-    // the segment's vertices (and centre) on the face, then on the master
-    let mut feet = [([0.0; 2], None::<[usize; 2]>); 9];
-    let mut n_feet = 0;
-    {
-        let centre = seg.iter().sum::<P2>() / seg.len() as f64;
-        for v in seg.iter().chain(std::iter::once(&centre)).take(feet.len()) {
-            let Some(eta) = plane.eta(v) else { continue };
-            let (x, _) = face_point(xf, eta);
-            let (p, element) = match geometry {
-                Projector::BSpline(pr) => (start.xi.map_or_else(|| pr.project(&x), |xi0| pr.project_warm(&x, xi0)), None),
-                Projector::Atlas(_) | Projector::Facet(_) => return,
-            };
-            if p.converged {
-                feet[n_feet] = (p.xi, element);
-                n_feet += 1;
+    // the parameter range of the segment's vertices (and centre) on the patch: a
+    // knot line that crosses the segment has its value inside it wherever ξ̄ varies
+    // monotonically over the segment (a flat net; on a curved one a line missed is
+    // a quadrature choice, not an error)
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    let centre = seg.iter().sum::<P2>() / seg.len() as f64;
+    for v in seg.iter().chain(std::iter::once(&centre)) {
+        let Some(eta) = plane.eta(v) else { continue };
+        let (x, _) = face_point(xf, eta);
+        let p = start.xi.map_or_else(|| pr.project(&x), |xi0| pr.project_warm(&x, xi0));
+        if p.converged {
+            for al in 0..2 {
+                lo[al] = lo[al].min(p.xi[al]);
+                hi[al] = hi[al].max(p.xi[al]);
             }
         }
     }
-    let feet = &feet[..n_feet];
-    match geometry {
-        Projector::BSpline(pr) => {
-            let patch = pr.patch();
-            let n_spans = patch.n_spans();
-            for al in 0..2 {
-                let be = 1 - al;
-                let (lo, hi) = feet.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), (xi, _)| (lo.min(xi[al]), hi.max(xi[al])));
-                // the line's two points half a span beyond the segment's range across
-                let (blo, bhi) = feet.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), (xi, _)| (lo.min(xi[be]), hi.max(xi[be])));
-                let pad = 0.5 / n_spans[be] as f64;
-                let (blo, bhi) = ((blo - pad).max(0.0), (bhi + pad).min(1.0));
-                for s in 1..n_spans[al] {
-                    let t = patch.knots(al).span_bounds(s).0;
-                    if t > lo && t < hi {
-                        let at = |b: f64| {
-                            let mut xi = [0.0; 2];
-                            xi[al] = t;
-                            xi[be] = b;
-                            pr.evaluate(xi)
-                        };
-                        line(&at(blo), &at(bhi), pieces);
-                    }
-                }
+    let patch = pr.patch();
+    let n_spans = patch.n_spans();
+    for al in 0..2 {
+        let be = 1 - al;
+        // the line's two points half a span beyond the segment's range across
+        let pad = 0.5 / n_spans[be] as f64;
+        let (blo, bhi) = ((lo[be] - pad).max(0.0), (hi[be] + pad).min(1.0));
+        for s in 1..n_spans[al] {
+            let t = patch.knots(al).span_bounds(s).0;
+            if t > lo[al] && t < hi[al] {
+                let at = |b: f64| {
+                    let mut xi = [0.0; 2];
+                    xi[al] = t;
+                    xi[be] = b;
+                    pr.evaluate(xi)
+                };
+                line(&at(blo), &at(bhi), pieces);
             }
         }
-        // an atlas's charts: not cut (see the function's docs)
-        Projector::Atlas(_) | Projector::Facet(_) => {}
     }
 }
 
