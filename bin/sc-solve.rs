@@ -26,7 +26,8 @@ use splinecontact::stages::solve;
 ///                  penetration_tolerance: 1.0e-4, max_augmentations: 20}]
 ///   increments:  {count: 10, max_cutbacks: 5}
 ///   newton:      {max_iterations: 25, residual_tolerance: 1.0e-8, energy_tolerance: 1.0e-12}
-///   linear_solver: auto   # Cholesky (nested dissection); with friction GMRES
+///   linear_solver: auto   # Cholesky (nested dissection), kept while GMRES
+///                         # solves the next tangents with it; with friction GMRES
 ///                         # preconditioned by the symmetric part (LU fallback);
 ///                         # in a --features petsc build, from 300k dofs or
 ///                         # under mpirun: PETSc CG/GMRES + algebraic multigrid

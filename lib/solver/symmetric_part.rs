@@ -26,6 +26,22 @@
 //! [`GmresSettings::tolerance`] (1e-12 by default, far below Newton's 1e-8), so
 //! Newton's iterates, and its iteration counts, are those of the direct solve up
 //! to round-off.
+//!
+//! **Keeping the factorization.** A factorization of `S` is kept for the next Newton
+//! iteration while the last solve needed at most `reuse_below` GMRES iterations
+//! (the tangent then changes little from one iteration to the next); a kept one
+//! gets at most [`KEPT_BUDGET_FACTOR`] × `reuse_below` iterations, after which `S`
+//! is factored anew and the solve repeated. Every increment starts with a fresh
+//! factorization ([`LinearSolver::begin_increment`]).
+//!
+//! **A symmetric tangent** (frictionless, no follower pressure; `analyse` with
+//! [`Symmetry::Symmetric`]): `S = K`, so a fresh factorization solves `K x = b` in
+//! one GMRES iteration and a kept one is a preconditioner for the tangent it was
+//! not made of: a modified Newton method whose steps GMRES makes exact. Then `K`
+//! is stored once (no transpose map, no separate `S`), a factorization that fails
+//! is an error (a singular tangent is reported with its dof, as by
+//! [`FaerDirect`]; no LU), and a fresh factorization's GMRES solve is accepted
+//! however far it got, as a direct solve's result would be.
 
 use std::time::{Duration, Instant};
 
@@ -34,6 +50,10 @@ use rayon::prelude::*;
 
 use super::gmres::{gmres, GmresSettings};
 use super::linear::{check_values, FactorInfo, FaerDirect, FaerDirectOptions, Factorization, LinearSolver, LinearSolverError, SolveReport, SolverTimings, Symmetry};
+
+/// A kept factorization gets at most this many times `reuse_below` GMRES
+/// iterations before `S` is factored anew (a tangent that moved far from it).
+pub const KEPT_BUDGET_FACTOR: usize = 4;
 
 /// GMRES on `K`, preconditioned by the factorization of `(K + Kᵀ)/2`.
 pub struct SymmetricPartGmres {
@@ -46,15 +66,17 @@ pub struct SymmetricPartGmres {
     lu: FaerDirect,
     lu_analysed: bool,
     /// `analyse` succeeded (the pattern is held by `symmetric`, or by `lu` when
-    /// `transpose` is empty).
+    /// `transpose` is empty and the tangent is not symmetric).
     analysed: bool,
+    /// `K` is symmetric (`analyse` with [`Symmetry::Symmetric`]): `S = K`.
+    symmetric_tangent: bool,
     /// `transpose[p]`: position of entry `(j, i)` for the entry `(i, j)` at `p`;
     /// empty when the pattern is not structurally symmetric (then only LU is used).
     /// (The pattern itself is the inner factorizations'.)
     transpose: Vec<u32>,
     /// `Kᵀ` in the pattern's CSC order, that is `K` by rows (the only copy of `K`
     /// kept: `K[p] = values_t[transpose[p]]`); `K` itself when the pattern is not
-    /// structurally symmetric.
+    /// structurally symmetric or `K` is symmetric.
     values_t: Vec<f64>,
     /// Scratch: `S` for its factorization, or `K` for the LU fallback.
     s_values: Vec<f64>,
@@ -104,6 +126,7 @@ impl SymmetricPartGmres {
             lu: FaerDirect::new(direct),
             lu_analysed: false,
             analysed: false,
+            symmetric_tangent: false,
             transpose: Vec::new(),
             values_t: Vec::new(),
             s_values: Vec::new(),
@@ -124,14 +147,14 @@ impl SymmetricPartGmres {
     /// Whether a pattern of `nnz` entries goes to LU alone (not structurally
     /// symmetric: no transpose map).
     fn general_pattern(&self, nnz: usize) -> bool {
-        self.transpose.is_empty() && nnz > 0
+        !self.symmetric_tangent && self.transpose.is_empty() && nnz > 0
     }
 
     /// The analysed pattern (held by the inner factorization that uses it).
     fn pattern(&self) -> Option<&SymbolicSparseColMat<usize>> {
         if !self.analysed {
             None
-        } else if self.transpose.is_empty() {
+        } else if self.transpose.is_empty() && !self.symmetric_tangent {
             self.lu.pattern().or(self.symmetric.pattern())
         } else {
             self.symmetric.pattern()
@@ -140,7 +163,7 @@ impl SymmetricPartGmres {
 
     /// GMRES on the stored `K` with the held factorization of `S`, right-hand side
     /// `self.rhs`, solution into `x`.
-    fn run_gmres(&mut self, x: &mut [f64]) -> Result<super::gmres::GmresOutcome, String> {
+    fn run_gmres(&mut self, x: &mut [f64], settings: GmresSettings) -> Result<super::gmres::GmresOutcome, String> {
         let symmetric = &self.symmetric;
         let pattern = symmetric.pattern().ok_or("no pattern")?;
         let n = pattern.nrows();
@@ -163,16 +186,21 @@ impl SymmetricPartGmres {
                 .collect();
             64.0 * f64::EPSILON * partial.iter().sum::<f64>().sqrt()
         };
-        gmres(&self.rhs, x, self.settings, &mut apply, &mut precondition, &mut floor)
+        gmres(&self.rhs, x, settings, &mut apply, &mut precondition, &mut floor)
     }
 
-    /// Factor `S` of the stored values: `S[p] = (K[p] + Kᵀ[p]) / 2`.
+    /// Factor `S` of the stored values: `S[p] = (K[p] + Kᵀ[p]) / 2` (`K` itself
+    /// when it is symmetric).
     fn factor_symmetric(&mut self) -> Result<Factorization, LinearSolverError> {
-        let vt = &self.values_t;
-        self.s_values.clear();
-        self.s_values.extend(self.transpose.iter().zip(vt).map(|(&q, at)| 0.5 * (vt[q as usize] + at)));
         self.held = None;
-        let info = self.symmetric.factor(&self.s_values)?;
+        let info = if self.symmetric_tangent {
+            self.symmetric.factor(&self.values_t)?
+        } else {
+            let vt = &self.values_t;
+            self.s_values.clear();
+            self.s_values.extend(self.transpose.iter().zip(vt).map(|(&q, at)| 0.5 * (vt[q as usize] + at)));
+            self.symmetric.factor(&self.s_values)?
+        };
         self.held = Some(info.method);
         self.fresh = true;
         self.n_numeric += 1;
@@ -231,7 +259,11 @@ pub fn transpose_positions(pattern: SymbolicSparseColMatRef<'_, usize>) -> Optio
 
 impl LinearSolver for SymmetricPartGmres {
     fn name(&self) -> &str {
-        "faer-symmetric-part-gmres"
+        if self.symmetric_tangent {
+            "faer-cholesky-kept"
+        } else {
+            "faer-symmetric-part-gmres"
+        }
     }
 
     fn analyse(&mut self, pattern: SymbolicSparseColMatRef<'_, usize>, symmetry: Symmetry) -> Result<(), LinearSolverError> {
@@ -241,12 +273,14 @@ impl LinearSolver for SymmetricPartGmres {
         self.last_iterations = usize::MAX;
         self.lu_analysed = false;
         self.lu_reason = None;
-        let _ = symmetry; // K is treated as general whatever it is declared
+        self.symmetric_tangent = symmetry == Symmetry::Symmetric;
         // the old pattern's arrays and factors go first (peak memory)
         self.symmetric.release();
         self.lu.release();
         (self.transpose, self.values_t, self.s_values) = (Vec::new(), Vec::new(), Vec::new());
-        self.transpose = transpose_positions(pattern).unwrap_or_default();
+        if !self.symmetric_tangent {
+            self.transpose = transpose_positions(pattern).unwrap_or_default();
+        }
         // the inner factorizations own the pattern: S's, or LU's when the pattern is
         // not structurally symmetric
         if self.general_pattern(pattern.row_idx().len()) {
@@ -271,9 +305,13 @@ impl LinearSolver for SymmetricPartGmres {
             self.factor_lu("the pattern is not structurally symmetric".into())?;
             Factorization::Lu
         } else {
-            let t = &self.transpose;
             self.values_t.clear();
-            self.values_t.extend(t.iter().map(|&q| values[q as usize]));
+            if self.symmetric_tangent {
+                self.values_t.extend_from_slice(values);
+            } else {
+                let t = &self.transpose;
+                self.values_t.extend(t.iter().map(|&q| values[q as usize]));
+            }
             match self.held {
                 // the last solve converged quickly: the held S still preconditions well
                 Some(method) if self.last_iterations <= self.reuse_below => {
@@ -283,6 +321,9 @@ impl LinearSolver for SymmetricPartGmres {
                 }
                 _ => match self.factor_symmetric() {
                     Ok(method) => method,
+                    // a symmetric tangent that cannot be factored is reported (a
+                    // singular one with its dof), as the direct solver does
+                    Err(e) if self.symmetric_tangent => return Err(e),
                     Err(e) => {
                         self.factor_lu(format!("the symmetric part could not be factored ({e})"))?;
                         Factorization::Lu
@@ -318,16 +359,31 @@ impl LinearSolver for SymmetricPartGmres {
         }
         self.rhs.clear();
         self.rhs.extend_from_slice(rhs);
-        let mut outcome = self.run_gmres(rhs);
+        let settings = if self.fresh {
+            self.settings
+        } else {
+            // a kept factorization: a tangent far from it is factored anew instead
+            let budget = KEPT_BUDGET_FACTOR * self.reuse_below.max(1);
+            GmresSettings { max_iterations: self.settings.max_iterations.min(budget), ..self.settings }
+        };
+        let mut outcome = self.run_gmres(rhs, settings);
         let mut iterations = outcome.as_ref().map_or(0, |o| o.iterations);
         if !matches!(outcome, Ok(o) if o.converged) && !self.fresh {
             // a held factorization of an earlier S: factor the current one and retry
             let t = Instant::now();
             let refactored = self.factor_symmetric();
             self.numeric_time += t.elapsed();
-            if refactored.is_ok() {
-                outcome = self.run_gmres(rhs);
-                iterations += outcome.as_ref().map_or(0, |o| o.iterations);
+            match refactored {
+                Ok(_) => {
+                    outcome = self.run_gmres(rhs, self.settings);
+                    iterations += outcome.as_ref().map_or(0, |o| o.iterations);
+                }
+                Err(e) if self.symmetric_tangent => {
+                    self.last_iterations = usize::MAX;
+                    self.solve_time += start.elapsed();
+                    return Err(e);
+                }
+                Err(_) => {}
             }
         }
         self.n_krylov += iterations;
@@ -336,6 +392,17 @@ impl LinearSolver for SymmetricPartGmres {
                 self.last_iterations = iterations;
                 self.last = SolveReport { krylov_iterations: iterations, fallback: None };
                 Ok(())
+            }
+            // a symmetric tangent's own factorization: its solve stands, as a direct
+            // solve's would (an ill-conditioned K; Newton's residual judges it)
+            Ok(_) if self.symmetric_tangent && rhs.iter().all(|v| v.is_finite()) => {
+                self.last_iterations = usize::MAX;
+                self.last = SolveReport { krylov_iterations: iterations, fallback: None };
+                Ok(())
+            }
+            Ok(_) | Err(_) if self.symmetric_tangent => {
+                self.last_iterations = usize::MAX;
+                Err(LinearSolverError::Singular { dof: None })
             }
             other => {
                 let why = match other {
@@ -516,6 +583,76 @@ mod tests {
             every.solve_in_place(&mut x).unwrap();
         }
         assert_eq!((every.timings().n_numeric, every.timings().n_reused), (2, 0));
+    }
+
+    #[test]
+    fn a_symmetric_tangent_keeps_its_cholesky_factor_while_it_preconditions_well() {
+        let (p, v, b) = skewed(0.0);
+        let mut s = SymmetricPartGmres::with_reuse(GmresSettings::default(), FaerDirectOptions::default(), 8);
+        s.analyse(p.as_ref(), Symmetry::Symmetric).unwrap();
+        assert_eq!(s.name(), "faer-cholesky-kept");
+        // no transpose map: K is stored once
+        assert!(s.transpose.is_empty());
+        // a fresh factor: one GMRES iteration, the direct solve's answer
+        assert_eq!(s.factor(&v).unwrap().method, Factorization::Llt);
+        let mut x = b.clone();
+        s.solve_in_place(&mut x).unwrap();
+        assert_eq!(s.last_solve().krylov_iterations, 1, "{:?}", s.last_solve());
+        let mut direct = FaerDirect::default();
+        direct.analyse(p.as_ref(), Symmetry::Symmetric).unwrap();
+        direct.factor(&v).unwrap();
+        let mut y = b.clone();
+        direct.solve_in_place(&mut y).unwrap();
+        let scale = y.iter().map(|v| v.abs()).fold(0.0, f64::max);
+        let d = x.iter().zip(&y).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+        assert!(d <= 1e-12 * scale, "differs from the direct solve by {:e}", d / scale);
+        // a nearby tangent (a stiffer diagonal, as contact adds): the kept factor,
+        // GMRES to the tolerance, no new factorization
+        let mut v2 = v.clone();
+        for j in 0..p.ncols() {
+            let (lo, hi) = (p.col_ptr()[j], p.col_ptr()[j + 1]);
+            let d = lo + p.row_idx()[lo..hi].binary_search(&j).unwrap();
+            v2[d] *= 1.0 + 0.005 * ((j % 7) as f64) / 7.0;
+        }
+        s.factor(&v2).unwrap();
+        assert!(!s.fresh);
+        let mut x = b.clone();
+        s.solve_in_place(&mut x).unwrap();
+        let its = s.last_solve().krylov_iterations;
+        assert!(residual(&p, &v2, &x, &b) <= 1e-12 && (2..=8).contains(&its), "{its} iterations");
+        assert_eq!((s.timings().n_numeric, s.timings().n_reused), (1, 1));
+        // a far one: the kept factor misses its budget of 4 x 8 iterations and K is
+        // factored anew (one more factorization, no LU)
+        let mut v3 = v.clone();
+        for j in 0..p.ncols() {
+            let (lo, hi) = (p.col_ptr()[j], p.col_ptr()[j + 1]);
+            let d = lo + p.row_idx()[lo..hi].binary_search(&j).unwrap();
+            v3[d] *= if j % 2 == 0 { 50.0 } else { 0.6 };
+        }
+        s.factor(&v3).unwrap();
+        let mut x = b.clone();
+        s.solve_in_place(&mut x).unwrap();
+        let t = s.timings();
+        assert!(residual(&p, &v3, &x, &b) <= 1e-12 && s.fresh, "{:?}", s.last_solve());
+        assert_eq!((t.n_numeric, t.n_reused, t.n_fallback), (2, 2, 0), "{t:?}");
+        assert!(s.last_solve().krylov_iterations <= KEPT_BUDGET_FACTOR * 8 + 1, "{:?}", s.last_solve());
+        // a new increment starts from a fresh factorization
+        s.begin_increment();
+        s.factor(&v).unwrap();
+        assert!(s.fresh);
+    }
+
+    #[test]
+    fn a_singular_symmetric_tangent_is_reported_with_its_dof() {
+        // diag(1, 0): the second dof is not held; no LU fallback hides it
+        let p = SymbolicSparseColMat::new_checked(2, 2, vec![0, 2, 4], None, vec![0, 1, 0, 1]);
+        let v = vec![1.0, 0.0, 0.0, 0.0];
+        let mut s = SymmetricPartGmres::with_reuse(GmresSettings::default(), FaerDirectOptions::default(), 8);
+        s.analyse(p.as_ref(), Symmetry::Symmetric).unwrap();
+        match s.factor(&v) {
+            Err(LinearSolverError::Singular { dof: Some(1) }) => {}
+            other => panic!("{other:?}"),
+        }
     }
 
     #[test]

@@ -207,8 +207,11 @@ impl<'p> Newton<'p> {
         let mut linear: Box<dyn LinearSolver> = if petsc {
             petsc_backend(&linear_setup, problem)?
         } else {
-            match (symmetry, choice) {
-                (Symmetry::General, LinearSolverChoice::Auto | LinearSolverChoice::Direct | LinearSolverChoice::Gmres) => {
+            match choice {
+                // the symmetric tangent's Cholesky factorization kept across Newton
+                // iterations while GMRES solves with it quickly; the non-symmetric
+                // one's GMRES on the factorization of its symmetric part
+                LinearSolverChoice::Auto | LinearSolverChoice::Direct | LinearSolverChoice::Gmres => {
                     Box::new(SymmetricPartGmres::with_reuse(gmres, direct, linear_setup.preconditioner_reuse as usize))
                 }
                 _ => Box::new(FaerDirect::new(direct)),
@@ -218,7 +221,11 @@ impl<'p> Newton<'p> {
         let n = DOFS_PER_NODE * problem.n_nodes();
         let n_free = pattern.n_free();
         let stabilization = Stabilization::new(problem, &contact);
-        let forcing = linear_setup.inexact_newton.then(|| Forcing::new(FORCING_MAX, settings.residual_tolerance));
+        // Inexact Newton for the iterative solves of a non-symmetric tangent and
+        // PETSc's; a symmetric tangent's kept factorization solves to the GMRES
+        // tolerance, so Newton's iterates are the direct solve's.
+        let iterative = petsc || symmetry == Symmetry::General;
+        let forcing = (linear_setup.inexact_newton && iterative).then(|| Forcing::new(FORCING_MAX, settings.residual_tolerance));
         Ok(Self {
             problem,
             settings,
