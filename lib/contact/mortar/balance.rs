@@ -34,21 +34,13 @@
 //! where T_k's derivatives jump, and the open patch's parameter is not affine in x
 //! near its edges; both are quadrature errors of the uniform pressure's forces.
 
+use super::segment::gauss_legendre;
 use super::trace::Trace;
 use crate::contact::master::Projector;
 use crate::spline::{SurfaceBasis, Vec3};
 
-/// Gauss–Legendre points on [0, 1] and their weights (8 points: degree 15).
-const GAUSS: [(f64, f64); 8] = [
-    (0.019855071751231912, 0.05061426814518853),
-    (0.10166676129318664, 0.11119051722668721),
-    (0.2372337950418355, 0.15685332293894344),
-    (0.4082826787521751, 0.18134189168918083),
-    (0.5917173212478248, 0.18134189168918083),
-    (0.7627662049581645, 0.15685332293894344),
-    (0.8983332387068134, 0.11119051722668721),
-    (0.9801449282487681, 0.05061426814518853),
-];
+/// Gauss–Legendre points per direction of the surface and facet integrals (degree 15).
+const GAUSS_POINTS: usize = 8;
 
 /// The recombination M of a master net's basis (module docs), stored by columns:
 /// the nodes k that receive a share M_kA of Q_A.
@@ -198,6 +190,7 @@ impl Balance {
 /// q_A = ∫ Q_A dA over the smooth master, by 8 × 8 Gauss points per knot span (one
 /// patch) or per chart (an atlas: each chart the unit square).
 fn surface_integrals(geometry: &Projector, n: usize) -> Vec<f64> {
+    let gauss = gauss_legendre(GAUSS_POINTS);
     let mut q = vec![0.0; n];
     let mut add = |xi: [f64; 2], cell: Option<[usize; 2]>, w: f64| {
         let sp = geometry.evaluate(xi, cell);
@@ -214,8 +207,8 @@ fn surface_integrals(geometry: &Projector, n: usize) -> Vec<f64> {
                 let (b0, b1) = patch.knots(1).span_bounds(sb);
                 for sa in 0..na {
                     let (a0, a1) = patch.knots(0).span_bounds(sa);
-                    for &(u, wu) in &GAUSS {
-                        for &(v, wv) in &GAUSS {
+                    for &(u, wu) in &gauss {
+                        for &(v, wv) in &gauss {
                             add([a0 + (a1 - a0) * u, b0 + (b1 - b0) * v], Some([sa, sb]), wu * wv * (a1 - a0) * (b1 - b0));
                         }
                     }
@@ -224,8 +217,8 @@ fn surface_integrals(geometry: &Projector, n: usize) -> Vec<f64> {
         }
         _ => {
             for c in 0..geometry.n_charts() {
-                for &(u, wu) in &GAUSS {
-                    for &(v, wv) in &GAUSS {
+                for &(u, wu) in &gauss {
+                    for &(v, wv) in &gauss {
                         add([u, v], Some([c, 0]), wu * wv);
                     }
                 }
@@ -238,12 +231,13 @@ fn surface_integrals(geometry: &Projector, n: usize) -> Vec<f64> {
 /// f_k = ∫ N^F_k dA over the trace's bilinear facets (corner cycle x_00, x_10, x_11,
 /// x_01), 8 × 8 Gauss points per cell.
 fn facet_integrals(trace: &Trace, x_net: &[Vec3]) -> Vec<f64> {
+    let gauss = gauss_legendre(GAUSS_POINTS);
     let mut f = vec![0.0; x_net.len()];
     for c in 0..trace.n_cells() {
         let k = trace.corners(c);
         let x = k.map(|k| x_net[k as usize]);
-        for &(s, ws) in &GAUSS {
-            for &(t, wt) in &GAUSS {
+        for &(s, ws) in &gauss {
+            for &(t, wt) in &gauss {
                 let n = [(1.0 - s) * (1.0 - t), s * (1.0 - t), s * t, (1.0 - s) * t];
                 let xs = (x[1] - x[0]) * (1.0 - t) + (x[2] - x[3]) * t;
                 let xt = (x[3] - x[0]) * (1.0 - s) + (x[2] - x[1]) * s;

@@ -200,23 +200,28 @@ pub fn clip_convex(subject: &[P2], clip: &[P2], out: &mut Vec<P2>, scratch: &mut
     let n = clip.len();
     for e in 0..n {
         let (a, b) = (clip[e], clip[(e + 1) % n]);
-        let side = |p: &P2| cross(&(b - a), &(p - a));
         std::mem::swap(out, scratch);
         out.clear();
-        let m = scratch.len();
-        for i in 0..m {
-            let (p, q) = (scratch[i], scratch[(i + 1) % m]);
-            let (sp, sq) = (side(&p), side(&q));
-            if sp >= 0.0 {
-                out.push(p);
-            }
-            if (sp >= 0.0) != (sq >= 0.0) {
-                let t = sp / (sp - sq);
-                out.push(p + (q - p) * t);
-            }
-        }
+        clip_half_plane(scratch, |p| cross(&(b - a), &(p - a)), out);
         if out.is_empty() {
             return;
+        }
+    }
+}
+
+/// One Sutherland–Hodgman pass: appends to `out` the part of the polygon `poly`
+/// where `side(p) ≥ 0` (`side` affine in `p`: the crossings are interpolated).
+fn clip_half_plane(poly: &[P2], side: impl Fn(&P2) -> f64, out: &mut Vec<P2>) {
+    let m = poly.len();
+    for i in 0..m {
+        let (p, q) = (poly[i], poly[(i + 1) % m]);
+        let (sp, sq) = (side(&p), side(&q));
+        if sp >= 0.0 {
+            out.push(p);
+        }
+        if (sp >= 0.0) != (sq >= 0.0) {
+            let t = sp / (sp - sq);
+            out.push(p + (q - p) * t);
         }
     }
 }
@@ -328,20 +333,8 @@ impl Pieces {
             let poly = &self.points[lo..hi];
             lo = hi;
             for sign in [1.0, -1.0] {
-                let side = |p: &P2| sign * cross(&(b - a), &(p - a));
                 let first = self.next_points.len();
-                let m = poly.len();
-                for i in 0..m {
-                    let (p, q) = (poly[i], poly[(i + 1) % m]);
-                    let (sp, sq) = (side(&p), side(&q));
-                    if sp >= 0.0 {
-                        self.next_points.push(p);
-                    }
-                    if (sp >= 0.0) != (sq >= 0.0) {
-                        let t = sp / (sp - sq);
-                        self.next_points.push(p + (q - p) * t);
-                    }
-                }
+                clip_half_plane(poly, |p| sign * cross(&(b - a), &(p - a)), &mut self.next_points);
                 let part = &self.next_points[first..];
                 if part.len() >= 3 && signed_area2(part) > min_a2 {
                     self.next_ends.push(self.next_points.len());
