@@ -541,6 +541,17 @@ mod tests {
         relative_residual(p.col_ptr(), p.row_idx(), v, x, b)
     }
 
+    /// The values `v` with each diagonal entry `j` multiplied by `factor(j)`.
+    fn scale_diagonal(p: &SymbolicSparseColMat<usize>, v: &[f64], factor: impl Fn(usize) -> f64) -> Vec<f64> {
+        let mut out = v.to_vec();
+        for j in 0..p.ncols() {
+            let (lo, hi) = (p.col_ptr()[j], p.col_ptr()[j + 1]);
+            let d = lo + p.row_idx()[lo..hi].binary_search(&j).unwrap();
+            out[d] *= factor(j);
+        }
+        out
+    }
+
     #[test]
     fn keeps_the_factorization_while_gmres_converges_quickly() {
         let (p, v, b) = skewed(0.002);
@@ -561,12 +572,7 @@ mod tests {
         assert_eq!((t.n_numeric, t.n_reused), (1, 1));
         // a far one: the stale S misses the budget, S is factored anew and GMRES
         // converges (no LU)
-        let mut v3 = v.clone();
-        for j in 0..p.ncols() {
-            let (lo, hi) = (p.col_ptr()[j], p.col_ptr()[j + 1]);
-            let d = lo + p.row_idx()[lo..hi].binary_search(&j).unwrap();
-            v3[d] *= if j % 2 == 0 { 50.0 } else { 0.6 };
-        }
+        let v3 = scale_diagonal(&p, &v, |j| if j % 2 == 0 { 50.0 } else { 0.6 });
         s.factor(&v3).unwrap();
         let mut x = b.clone();
         s.solve_in_place(&mut x).unwrap();
@@ -608,12 +614,7 @@ mod tests {
         assert!(d <= 1e-12 * scale, "differs from the direct solve by {:e}", d / scale);
         // a nearby tangent (a stiffer diagonal, as contact adds): the kept factor,
         // GMRES to the tolerance, no new factorization
-        let mut v2 = v.clone();
-        for j in 0..p.ncols() {
-            let (lo, hi) = (p.col_ptr()[j], p.col_ptr()[j + 1]);
-            let d = lo + p.row_idx()[lo..hi].binary_search(&j).unwrap();
-            v2[d] *= 1.0 + 0.005 * ((j % 7) as f64) / 7.0;
-        }
+        let v2 = scale_diagonal(&p, &v, |j| 1.0 + 0.005 * ((j % 7) as f64) / 7.0);
         s.factor(&v2).unwrap();
         assert!(!s.fresh);
         let mut x = b.clone();
@@ -623,12 +624,7 @@ mod tests {
         assert_eq!((s.timings().n_numeric, s.timings().n_reused), (1, 1));
         // a far one: the kept factor misses its budget of 4 x 8 iterations and K is
         // factored anew (one more factorization, no LU)
-        let mut v3 = v.clone();
-        for j in 0..p.ncols() {
-            let (lo, hi) = (p.col_ptr()[j], p.col_ptr()[j + 1]);
-            let d = lo + p.row_idx()[lo..hi].binary_search(&j).unwrap();
-            v3[d] *= if j % 2 == 0 { 50.0 } else { 0.6 };
-        }
+        let v3 = scale_diagonal(&p, &v, |j| if j % 2 == 0 { 50.0 } else { 0.6 });
         s.factor(&v3).unwrap();
         let mut x = b.clone();
         s.solve_in_place(&mut x).unwrap();
