@@ -329,3 +329,36 @@ fn assembled_contact_tangent_matches_finite_differences() {
     }
 }
 
+
+/// The symmetric tangent's Cholesky factor kept across Newton iterations
+/// (`linear_solver: auto`) against a fresh factorization every iteration
+/// (`cholesky`): a neo-Hookean slave block pressed 10 % into a B-spline master in 3
+/// increments, augmented Lagrangian, so each increment has several Newton solves
+/// whose tangents move (finite strain, contact). GMRES solves with the kept factor
+/// to 1e-12, so the Newton paths are the same: the same iteration counts and
+/// displacements to 1e-9 of the largest (Newton's tolerance is 1e-10; measured
+/// 1e-14). The kept factor must actually be used (Krylov iterations > 1 on some
+/// iteration, that is a factor of an earlier tangent), or the test shows nothing.
+#[test]
+fn a_kept_cholesky_factor_follows_the_fresh_factorizations_newton_path() {
+    let mesh = stacked(4, 3);
+    let base = patch_setup("augmented_lagrangian", 1.0e5, 0.05)
+        .replace("model: linear_elastic", "model: neo_hookean")
+        .replace("newton: {residual_tolerance: 1.0e-10}", "newton: {residual_tolerance: 1.0e-10}\nincrements: {count: 3}");
+    let spec = || pair(MasterKind::Bspline, Some([3, 3]), "upper_z0", "lower_z1");
+    let kept = run_contact(&mesh, &[spec()], &base);
+    let fresh = run_contact(&mesh, &[spec()], &format!("{base}linear_solver: cholesky\n"));
+    assert_eq!(kept.increments.len(), 3);
+    let mut kept_solves = 0;
+    for (n, (k, f)) in kept.increments.iter().zip(&fresh.increments).enumerate() {
+        assert_eq!(k.info.iterations.len(), f.info.iterations.len(), "Newton iterations of increment {}", n + 1);
+        assert!(f.info.iterations.iter().all(|it| it.krylov_iterations == 0));
+        kept_solves += k.info.iterations.iter().filter(|it| it.krylov_iterations > 1).count();
+        let scale = f.u.iter().flat_map(|u| u.iter()).fold(0.0f64, |m, v| m.max(v.abs()));
+        let diff = k.u.iter().zip(&f.u).flat_map(|(a, b)| a.iter().zip(b).map(|(x, y)| (x - y).abs())).fold(0.0f64, f64::max);
+        eprintln!("increment {}: {} Newton rows, max |u| {scale:.6e}, kept − fresh {:.2e}", n + 1, k.info.iterations.len(), diff / scale);
+        assert!(diff <= 1e-9 * scale, "increment {}: {:e}", n + 1, diff / scale);
+    }
+    eprintln!("solves with a kept factor: {kept_solves}");
+    assert!(kept_solves >= 10, "the kept factor was used in {kept_solves} solves (measured 27 of 45 rows)");
+}
