@@ -223,11 +223,11 @@ pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, 
         t.solve.as_secs_f64(),
         if t.n_krylov > 0 || t.n_fallback > 0 {
             format!(
-                ", {} Krylov iterations ({:.1} per solve), {} preconditioners kept from the iteration before, {} solved by the direct fallback",
+                ", {} Krylov iterations ({:.1} per solve), {} factorizations kept from the iteration before{}",
                 t.n_krylov,
                 t.n_krylov as f64 / t.n_solve.max(1) as f64,
                 t.n_reused,
-                t.n_fallback
+                if t.n_fallback > 0 { format!(", {} solved by the direct fallback", t.n_fallback) } else { String::new() }
             )
         } else {
             String::new()
