@@ -197,18 +197,13 @@ impl SymmetricPartGmres {
         GmresSettings { max_iterations: self.settings.max_iterations.min(budget), ..self.settings }
     }
 
-    /// Factor `S` of the stored values: `S[p] = (K[p] + Kᵀ[p]) / 2` (`K` itself
-    /// when it is symmetric: the stored values are `K`).
+    /// Factor `S` of the stored values: `S[p] = (K[p] + Kᵀ[p]) / 2`.
     fn factor_symmetric(&mut self) -> Result<Factorization, LinearSolverError> {
+        let vt = &self.values_t;
+        self.s_values.clear();
+        self.s_values.extend(self.transpose.iter().zip(vt).map(|(&q, at)| 0.5 * (vt[q as usize] + at)));
         self.held = None;
-        let info = if self.symmetric_tangent {
-            self.symmetric.factor(&self.values_t)?
-        } else {
-            let vt = &self.values_t;
-            self.s_values.clear();
-            self.s_values.extend(self.transpose.iter().zip(vt).map(|(&q, at)| 0.5 * (vt[q as usize] + at)));
-            self.symmetric.factor(&self.s_values)?
-        };
+        let info = self.symmetric.factor(&self.s_values)?;
         self.held = Some(info.method);
         self.fresh = true;
         self.n_numeric += 1;
@@ -256,14 +251,19 @@ impl SymmetricPartGmres {
             _ => {
                 // the copy of an earlier K goes before the factorization (peak memory)
                 self.values_t = Vec::new();
-                self.held = None;
-                let info = self.symmetric.factor(values)?;
-                self.held = Some(info.method);
-                self.fresh = true;
-                self.n_numeric += 1;
-                Ok(info.method)
+                self.factor_tangent(values)
             }
         }
+    }
+
+    /// Factor the symmetric tangent `K` itself, and hold the factorization.
+    fn factor_tangent(&mut self, values: &[f64]) -> Result<Factorization, LinearSolverError> {
+        self.held = None;
+        let info = self.symmetric.factor(values)?;
+        self.held = Some(info.method);
+        self.fresh = true;
+        self.n_numeric += 1;
+        Ok(info.method)
     }
 
     /// `solve_in_place` of a symmetric tangent: directly with a fresh factorization
@@ -285,9 +285,12 @@ impl SymmetricPartGmres {
             self.last_iterations = iterations;
             Ok(())
         } else {
-            // the tangent moved far from the kept factorization: factor it
+            // the tangent moved far from the kept factorization: factor it (its
+            // values, the copy, go with it)
             let t = Instant::now();
-            let refactored = self.factor_symmetric();
+            let k = std::mem::take(&mut self.values_t);
+            let refactored = self.factor_tangent(&k);
+            drop(k);
             self.numeric_time += t.elapsed();
             refactored.and_then(|_| {
                 rhs.copy_from_slice(&self.rhs);
