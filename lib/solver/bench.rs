@@ -246,22 +246,26 @@ mod orderings {
     #[ignore]
     fn bench_orderings_and_threads() {
         let sizes: Vec<usize> = std::env::var("SC_BENCH_CUBES").ok().map_or(vec![20, 30], |s| s.split(',').filter_map(|v| v.trim().parse().ok()).collect());
-        println!("| cube | dofs | ordering | threads | L entries | widest supernode | factor s | solve s |");
-        println!("|---|---|---|---|---|---|---|---|");
+        println!("| cube | dofs | ordering | threads | numeric LLᵀ | L entries | widest supernode | factor s | solve s |");
+        println!("|---|---|---|---|---|---|---|---|---|");
         for n in sizes {
             for ordering in [FillOrdering::NestedDissection, FillOrdering::Amd] {
                 for (threads, par) in [(1, Par::Seq), (2, Par::rayon(2))] {
-                    let mut s = FaerDirect::new(FaerDirectOptions { par: Some(par), ordering, ..Default::default() });
-                    let t = elastic_cube(n, &mut s, Symmetry::Symmetric).unwrap();
-                    assert!(t.relative_residual < 1e-10);
-                    println!(
-                        "| {n}³ | {} | {ordering:?} | {threads} | {} | {} | {:.3} | {:.4} |",
-                        t.n_free,
-                        s.factor_len(),
-                        s.largest_supernode(),
-                        t.numeric.as_secs_f64(),
-                        t.solve.as_secs_f64()
-                    );
+                    for elimination_tree in [false, true] {
+                        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+                        let mut s = FaerDirect::new(FaerDirectOptions { par: Some(par), ordering, elimination_tree, ..Default::default() });
+                        let t = pool.install(|| elastic_cube(n, &mut s, Symmetry::Symmetric)).unwrap();
+                        assert!(t.relative_residual < 1e-10);
+                        println!(
+                            "| {n}³ | {} | {ordering:?} | {threads} | {} | {} | {} | {:.3} | {:.4} |",
+                            t.n_free,
+                            if elimination_tree { "tree" } else { "faer" },
+                            s.factor_len(),
+                            s.largest_supernode(),
+                            t.numeric.as_secs_f64(),
+                            t.solve.as_secs_f64()
+                        );
+                    }
                 }
             }
         }

@@ -6,7 +6,8 @@
 //! of [`Symmetry`] needs a new `analyse`.
 //!
 //! **Which factorization.** [`Symmetry::Symmetric`]: `LLᵀ` (Cholesky, nested
-//! dissection or AMD ordering ([`crate::solver::ordering`]), supernodal) for the symmetric positive definite tangent; when it
+//! dissection or AMD ordering ([`crate::solver::ordering`]), supernodal, its numeric
+//! part by [`super::tree_cholesky`], parallel over the elimination tree) for the symmetric positive definite tangent; when it
 //! meets a non-positive pivot, `LDLᵀ` on the same symbolic factorization
 //! (symmetric indefinite, no pivoting: fails only on a zero pivot).
 //! [`Symmetry::General`]: `LU` with partial pivoting (COLAMD ordering). On 3D
@@ -24,13 +25,16 @@
 //! non-finite solution is reported as singular.
 //!
 //! **Threads and determinism.** The library never calls
-//! `faer::set_global_parallelism`. Parallelism is
-//! [`FaerDirectOptions::par`]: `None` runs faer sequentially on factors whose widest
-//! supernode is narrower than [`PARALLEL_SUPERNODE`] and with faer's global setting
-//! (default: all rayon threads) above, `Some(par)` passes `par` explicitly to every
-//! faer call. For
-//! bit-identical reruns fix it (`Par::Seq`, or `Par::rayon(n)` with a fixed `n`):
-//! faer's blocked kernels may split work differently for different thread counts.
+//! `faer::set_global_parallelism`. The `LLᵀ` factors independent subtrees of the
+//! elimination tree on rayon's threads, and gives the dense kernels of its wide top
+//! supernodes [`FaerDirectOptions::par`] (`None`: faer's global setting, default
+//! all rayon threads). For every other faer call (`LDLᵀ`, `LU`, the solves),
+//! `None` runs faer sequentially on factors whose widest supernode is narrower than
+//! [`PARALLEL_SUPERNODE`] and with faer's global setting above; `Some(par)` passes
+//! `par` explicitly. For bit-identical reruns fix it (`Par::Seq`, or
+//! `Par::rayon(n)` with a fixed `n`): faer's blocked kernels may split work
+//! differently for different thread counts. With `Par::Seq` the `LLᵀ` factor is
+//! the same, bit for bit, for any number of rayon threads.
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
@@ -52,6 +56,7 @@ use faer::perm::PermRef;
 use faer::{Conj, MatMut, Par, Side};
 
 use super::error::LinearSolverError;
+use super::tree_cholesky::TreeCholesky;
 use crate::solver::ordering::{nested_dissection, FillOrdering};
 use super::interface::{check_values, FactorInfo, Factorization, LinearSolver, SolverTimings, Symmetry};
 
@@ -73,11 +78,15 @@ pub struct FaerDirectOptions {
     /// Fill-reducing ordering of the Cholesky-type factorizations (LU always uses
     /// faer's COLAMD).
     pub ordering: FillOrdering,
+    /// `LLᵀ` by [`TreeCholesky`] (parallel over the elimination tree; default)
+    /// instead of faer's numeric supernodal factorization (sequential over the
+    /// supernodes). Both fill the same factor layout; `LDLᵀ` is always faer's.
+    pub elimination_tree: bool,
 }
 
 impl Default for FaerDirectOptions {
     fn default() -> Self {
-        Self { par: None, symmetric: SymmetricStrategy::LltThenLdlt, singular_pivot_tolerance: 1e-13, ordering: FillOrdering::default() }
+        Self { par: None, symmetric: SymmetricStrategy::LltThenLdlt, singular_pivot_tolerance: 1e-13, ordering: FillOrdering::default(), elimination_tree: true }
     }
 }
 
@@ -119,6 +128,8 @@ pub struct FaerDirect {
     /// Columns of the widest supernode of the Cholesky-type symbolic factor (0 for
     /// none or LU): decides the automatic parallelism ([`PARALLEL_SUPERNODE`]).
     widest_supernode: usize,
+    /// The elimination-tree schedule of the supernodal `LLᵀ` (set by `analyse`).
+    tree: Option<TreeCholesky>,
     symbolic_time: Duration,
     numeric_time: Duration,
     n_symbolic: usize,
@@ -143,6 +154,7 @@ impl FaerDirect {
             numeric: Numeric::None,
             l_values: Vec::new(),
             widest_supernode: 0,
+            tree: None,
             symbolic_time: Duration::ZERO,
             numeric_time: Duration::ZERO,
             n_symbolic: 0,
@@ -197,7 +209,6 @@ impl FaerDirect {
             return Err(LinearSolverError::Order("factor", "analyse"));
         };
         let a = SparseColMatRef::new(pattern.as_ref(), values);
-        self.l_values.resize(sym.len_val(), 0.0);
         let orig = |j: usize| sym.perm().map_or(j, |p| p.arrays().0[j]);
         // faer 0.24 reports failed pivots 1-based in the simplicial path
         // (`index: k + 1`) and 0-based in the supernodal one.
@@ -206,7 +217,53 @@ impl FaerDirect {
 
         let strategy = self.options.symmetric;
         let mut method = Factorization::Ldlt;
-        if strategy != SymmetricStrategy::Ldlt {
+        let tree = match (&self.tree, sym.raw()) {
+            (Some(tree), SymbolicCholeskyRaw::Supernodal(s)) if self.options.elimination_tree => Some((tree, s)),
+            _ => None,
+        };
+        if let (true, Some((tree, s))) = (strategy != SymmetricStrategy::Ldlt, tree) {
+            // the lower triangle of P A Pᵀ, as faer's own numeric factorization makes it
+            let n = sym.nrows();
+            let (cp, ri) = (pattern.col_ptr(), pattern.row_idx());
+            let nnz_lower = (0..n).map(|j| ri[cp[j]..cp[j + 1]].iter().filter(|&&i| i >= j).count()).sum::<usize>();
+            let mut new_val = vec![0.0; nnz_lower];
+            let mut new_col_ptr = vec![0usize; n + 1];
+            let mut new_row_idx = vec![0usize; nnz_lower];
+            let mut buf = MemBuffer::try_new(faer::sparse::utils::permute_self_adjoint_scratch::<usize>(n))
+                .map_err(|e| LinearSolverError::Faer(format!("{e:?}")))?;
+            let permuted;
+            let a_lower = match sym.perm() {
+                Some(perm) => {
+                    permuted = faer::sparse::utils::permute_self_adjoint_to_unsorted(
+                        &mut new_val,
+                        &mut new_col_ptr,
+                        &mut new_row_idx,
+                        a,
+                        perm,
+                        Side::Lower,
+                        Side::Lower,
+                        MemStack::new(&mut buf),
+                    );
+                    faer::reborrow::Reborrow::rb(&permuted)
+                }
+                None => a,
+            };
+            // the tasks write every block: no zeroing pass here, and the pages of a
+            // new factor are first touched in parallel (calloc'd, not written)
+            if self.l_values.len() != sym.len_val() {
+                self.l_values = vec![0.0; sym.len_val()];
+            }
+            let dense_par = self.options.par.unwrap_or_else(faer::get_global_parallelism);
+            match tree.factor(s, a_lower, &mut self.l_values, dense_par) {
+                Ok(()) => method = Factorization::Llt,
+                Err(LltError::NonPositivePivot { index }) => {
+                    if strategy == SymmetricStrategy::Llt {
+                        return Err(LinearSolverError::NotPositiveDefinite { dof: failed(index) });
+                    }
+                }
+            }
+        } else if strategy != SymmetricStrategy::Ldlt {
+            self.l_values.resize(sym.len_val(), 0.0);
             let mut buf = MemBuffer::try_new(sym.factorize_numeric_llt_scratch::<f64>(par, Default::default()))
                 .map_err(|e| LinearSolverError::Faer(format!("{e:?}")))?;
             let llt = sym.factorize_numeric_llt(
@@ -228,6 +285,7 @@ impl FaerDirect {
             }
         }
         if method == Factorization::Ldlt {
+            self.l_values.resize(sym.len_val(), 0.0);
             let mut buf = MemBuffer::try_new(sym.factorize_numeric_ldlt_scratch::<f64>(par, Default::default()))
                 .map_err(|e| LinearSolverError::Faer(format!("{e:?}")))?;
             let ldlt = sym.factorize_numeric_ldlt(
@@ -349,6 +407,13 @@ impl LinearSolver for FaerDirect {
             },
             Symbolic::Lu(_) => 0,
         };
+        self.tree = match &symbolic {
+            Symbolic::Cholesky(c) => match c.raw() {
+                SymbolicCholeskyRaw::Supernodal(s) => Some(TreeCholesky::new(s)),
+                SymbolicCholeskyRaw::Simplicial(_) => None,
+            },
+            Symbolic::Lu(_) => None,
+        };
         self.symbolic = Some(symbolic);
         self.symbolic_time += start.elapsed();
         self.n_symbolic += 1;
@@ -418,6 +483,7 @@ impl FaerDirect {
         self.diag_pos = Vec::new();
         self.l_values = Vec::new();
         self.widest_supernode = 0;
+        self.tree = None;
     }
 
     /// The analysed pattern, if any.

@@ -14,9 +14,11 @@
 //! | [`interface`] | the [`LinearSolver`] trait and what it reports |
 //! | [`error`] | [`LinearSolverError`] |
 //! | [`faer_direct`] | the faer backend: ordering and symbolic factorization once, `LLᵀ` → `LDLᵀ` or `LU` per Newton iteration, the singularity check |
+//! | [`tree_cholesky`] | the numeric supernodal `LLᵀ`, parallel over the elimination tree, into faer's factor layout |
 
 pub mod error;
 pub mod faer_direct;
+pub mod tree_cholesky;
 pub mod interface;
 
 pub use error::LinearSolverError;
