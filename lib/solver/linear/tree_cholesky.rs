@@ -46,10 +46,15 @@ use faer::sparse::linalg::cholesky::supernodal::SymbolicSupernodalCholesky;
 use faer::sparse::SparseColMatRef;
 use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::{Accum, MatMut, MatRef, Par};
+use rayon::prelude::*;
 
 /// Supernodes from this width on get the factorization's `par` for their dense
 /// kernels when no other task can run beside them.
 pub const DENSE_PARALLEL_COLUMNS: usize = 256;
+
+/// An update `W` of at least this many entries is scattered into `L_s` by
+/// several threads (when the supernode's `par` has them).
+const PARALLEL_SCATTER: usize = 1 << 16;
 
 /// A subtree whose factorization costs less than this many flops runs as one
 /// sequential task (spawning costs microseconds; this is ~0.1 ms of work).
@@ -84,6 +89,31 @@ struct SharedValues {
 unsafe impl Send for SharedValues {}
 unsafe impl Sync for SharedValues {}
 
+impl SharedValues {
+    /// `len` values from `offset` on, for reading.
+    ///
+    /// # Safety
+    /// `offset + len` within the array, and no one writes them while the slice
+    /// lives.
+    unsafe fn slice(&self, offset: usize, len: usize) -> &[f64] {
+        assert!(offset + len <= self.len, "a block inside the value array");
+        // SAFETY: in bounds (checked); not written by the caller's contract
+        unsafe { std::slice::from_raw_parts(self.ptr.add(offset), len) }
+    }
+
+    /// `len` values from `offset` on, for writing.
+    ///
+    /// # Safety
+    /// `offset + len` within the array, and no one else reads or writes them
+    /// while the slice lives.
+    #[allow(clippy::mut_from_ref)]
+    unsafe fn slice_mut(&self, offset: usize, len: usize) -> &mut [f64] {
+        assert!(offset + len <= self.len, "a block inside the value array");
+        // SAFETY: in bounds (checked); exclusive by the caller's contract
+        unsafe { std::slice::from_raw_parts_mut(self.ptr.add(offset), len) }
+    }
+}
+
 /// Per-thread scratch of [`Context::supernode`]: the global-to-local row map
 /// (`NONE` outside the supernode being factored), the update buffer `W`, and the
 /// dense Cholesky's workspace.
@@ -91,6 +121,7 @@ unsafe impl Sync for SharedValues {}
 struct Scratch {
     local: Vec<usize>,
     w: Vec<f64>,
+    map: Vec<usize>,
     dense: Option<MemBuffer>,
 }
 
@@ -258,15 +289,12 @@ impl Context<'_> {
         let s_ncols = s1 - s0;
         let s_nrows = s_ncols + s_pattern.len();
         // SAFETY: block `s` is written by this task only; see the module's Safety.
-        let ls_slice = unsafe {
-            assert!(val_ptr[s + 1] <= self.values.len);
-            std::slice::from_raw_parts_mut(self.values.ptr.add(val_ptr[s]), val_ptr[s + 1] - val_ptr[s])
-        };
+        let ls_slice = unsafe { self.values.slice_mut(val_ptr[s], val_ptr[s + 1] - val_ptr[s]) };
         ls_slice.fill(0.0);
         let mut ls = MatMut::from_column_major_slice_mut(ls_slice, s_nrows, s_ncols);
         let mut scratch = SCRATCH.with(Cell::take).unwrap_or_default();
         {
-            let Scratch { local, w: buffer, .. } = &mut *scratch;
+            let Scratch { local, w: buffer, map, .. } = &mut *scratch;
             if local.len() < sym.nrows() {
                 local.resize(sym.nrows(), NONE);
             }
@@ -291,7 +319,7 @@ impl Context<'_> {
                 let d_pattern = &rows[row_ptr[d]..row_ptr[d + 1]];
                 let d_nrows = d_ncols + d_pattern.len();
                 // SAFETY: `d` is a finished descendant of `s`: read only.
-                let ld = unsafe { std::slice::from_raw_parts(self.values.ptr.add(val_ptr[d]), val_ptr[d + 1] - val_ptr[d]) };
+                let ld = unsafe { self.values.slice(val_ptr[d], val_ptr[d + 1] - val_ptr[d]) };
                 let ld = MatRef::from_column_major_slice(ld, d_nrows, d_ncols);
                 let p0 = d_pattern.partition_point(|&r| r < s0);
                 let mid = d_pattern[p0..].partition_point(|&r| r < s1);
@@ -317,15 +345,26 @@ impl Context<'_> {
                     par,
                 );
                 matmul(w_bot, Accum::Replace, ld_low.subrows(mid, low - mid), ld_mid.transpose(), 1.0, par);
+                // the rows of W in L_s
+                map.clear();
+                map.extend(d_pattern[p0..].iter().map(|&r| if r < s1 { r - s0 } else { local[r] }));
                 let w = w.rb();
-                for jj in 0..mid {
-                    let col = d_pattern[p0 + jj] - s0;
-                    let w_col = w.col(jj);
-                    let mut dst = ls.rb_mut().col_mut(col);
+                let scatter = |jj: usize, dst: &mut [f64]| {
+                    let w_col = w.col(jj).try_as_col_major().expect("W is column-major").as_slice();
                     for ii in jj..low {
-                        let r = d_pattern[p0 + ii];
-                        let row = if r < s1 { r - s0 } else { local[r] };
-                        dst[row] -= w_col[ii];
+                        dst[map[ii]] -= w_col[ii];
+                    }
+                };
+                let ls_cols = SharedValues { ptr: ls.rb_mut().as_ptr_mut(), len: s_nrows * s_ncols };
+                // SAFETY: L_s is column-major with s_nrows rows, and the columns
+                // d_pattern[p0 + jj] − s₀ are distinct for distinct jj: each call
+                // writes its own column
+                let column = |jj: usize| unsafe { ls_cols.slice_mut((d_pattern[p0 + jj] - s0) * s_nrows, s_nrows) };
+                if matches!(par, Par::Rayon(_)) && low * mid >= PARALLEL_SCATTER {
+                    (0..mid).into_par_iter().for_each(|jj| scatter(jj, column(jj)));
+                } else {
+                    for jj in 0..mid {
+                        scatter(jj, column(jj));
                     }
                 }
             }
