@@ -18,8 +18,9 @@
 //! 1. scatter the lower triangle of `P A Pᵀ`'s columns `[s₀, s₁)` into `L_s`;
 //! 2. for every descendant `d` whose row pattern meets `[s₀, s₁)` (in increasing
 //!    order of `d`), with `L_d,mid` its rows in `[s₀, s₁)` and `L_d,low` its rows
-//!    from `s₀` on: `W = L_d,low L_d,midᵀ` (dense, into a buffer), then
-//!    `L_s[rows, cols] -= W` through the row map of `s`;
+//!    from `s₀` on: `W = L_d,low L_d,midᵀ` (dense, into a buffer, by panels of
+//!    columns that keep it under [`W_ENTRIES`]), then `L_s[rows, cols] -= W`
+//!    through the row map of `s`;
 //! 3. `L_s,top = chol(L_s,top)`, `L_s,bot ← L_s,bot L_s,top⁻ᵀ`.
 //!
 //! **Determinism.** Each supernode's operations and their order are fixed by the
@@ -51,6 +52,10 @@ use rayon::prelude::*;
 /// Supernodes from this width on get the factorization's `par` for their dense
 /// kernels when no other task can run beside them.
 pub const DENSE_PARALLEL_COLUMNS: usize = 256;
+
+/// Entries of the update buffer `W` of one thread (8 MB): a larger update goes
+/// by panels of columns.
+const W_ENTRIES: usize = 1 << 20;
 
 /// An update `W` of at least this many entries is scattered into `L_s` by
 /// several threads (when the supernode's `par` has them).
@@ -326,45 +331,53 @@ impl Context<'_> {
                 let low = d_pattern.len() - p0;
                 let ld_low = ld.subrows(d_ncols + p0, low);
                 let ld_mid = ld_low.subrows(0, mid);
-                if buffer.len() < low * mid {
-                    buffer.resize(low * mid, 0.0);
-                }
-                let mut w = MatMut::from_column_major_slice_mut(&mut buffer[..low * mid], low, mid);
-                // W = L_low L_midᵀ: the lower triangle of its top mid × mid block,
-                // and the rectangle below
-                let (w_top, w_bot) = w.rb_mut().split_at_row_mut(mid);
-                triangular::matmul(
-                    w_top,
-                    BlockStructure::TriangularLower,
-                    Accum::Replace,
-                    ld_mid,
-                    BlockStructure::Rectangular,
-                    ld_mid.transpose(),
-                    BlockStructure::Rectangular,
-                    1.0,
-                    par,
-                );
-                matmul(w_bot, Accum::Replace, ld_low.subrows(mid, low - mid), ld_mid.transpose(), 1.0, par);
                 // the rows of W in L_s
                 map.clear();
                 map.extend(d_pattern[p0..].iter().map(|&r| if r < s1 { r - s0 } else { local[r] }));
-                let w = w.rb();
-                let scatter = |jj: usize, dst: &mut [f64]| {
-                    let w_col = w.col(jj).try_as_col_major().expect("W is column-major").as_slice();
-                    for ii in jj..low {
-                        dst[map[ii]] -= w_col[ii];
-                    }
-                };
                 let ls_cols = SharedValues { ptr: ls.rb_mut().as_ptr_mut(), len: s_nrows * s_ncols };
-                // SAFETY: L_s is column-major with s_nrows rows, and the columns
-                // d_pattern[p0 + jj] − s₀ are distinct for distinct jj: each call
-                // writes its own column
-                let column = |jj: usize| unsafe { ls_cols.slice_mut((d_pattern[p0 + jj] - s0) * s_nrows, s_nrows) };
-                if matches!(par, Par::Rayon(_)) && low * mid >= PARALLEL_SCATTER {
-                    (0..mid).into_par_iter().for_each(|jj| scatter(jj, column(jj)));
-                } else {
-                    for jj in 0..mid {
-                        scatter(jj, column(jj));
+                // W = L_low L_midᵀ by panels of the mid columns [j0, j1), each the lower
+                // triangle of its top block and the rectangle below (the buffer stays
+                // under W_ENTRIES however large the update)
+                let width = (W_ENTRIES / low.max(1)).max(32).min(mid.max(1));
+                for j0 in (0..mid).step_by(width) {
+                    let j1 = (j0 + width).min(mid);
+                    let (cols, rows) = (j1 - j0, low - j0);
+                    if buffer.len() < rows * cols {
+                        buffer.resize(rows * cols, 0.0);
+                    }
+                    let mut w = MatMut::from_column_major_slice_mut(&mut buffer[..rows * cols], rows, cols);
+                    let panel = ld_mid.subrows(j0, cols);
+                    let (w_top, w_bot) = w.rb_mut().split_at_row_mut(cols);
+                    triangular::matmul(
+                        w_top,
+                        BlockStructure::TriangularLower,
+                        Accum::Replace,
+                        panel,
+                        BlockStructure::Rectangular,
+                        panel.transpose(),
+                        BlockStructure::Rectangular,
+                        1.0,
+                        par,
+                    );
+                    matmul(w_bot, Accum::Replace, ld_low.subrows(j1, low - j1), panel.transpose(), 1.0, par);
+                    let w = w.rb();
+                    let map = &map[j0..];
+                    let scatter = |jj: usize, dst: &mut [f64]| {
+                        let w_col = w.col(jj).try_as_col_major().expect("W is column-major").as_slice();
+                        for ii in jj..rows {
+                            dst[map[ii]] -= w_col[ii];
+                        }
+                    };
+                    // SAFETY: L_s is column-major with s_nrows rows, and the columns
+                    // d_pattern[p0 + j] − s₀ are distinct for distinct j: each call
+                    // writes its own column
+                    let column = |jj: usize| unsafe { ls_cols.slice_mut((d_pattern[p0 + j0 + jj] - s0) * s_nrows, s_nrows) };
+                    if matches!(par, Par::Rayon(_)) && rows * cols >= PARALLEL_SCATTER {
+                        (0..cols).into_par_iter().for_each(|jj| scatter(jj, column(jj)));
+                    } else {
+                        for jj in 0..cols {
+                            scatter(jj, column(jj));
+                        }
                     }
                 }
             }
