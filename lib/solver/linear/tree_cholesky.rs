@@ -53,9 +53,9 @@ use rayon::prelude::*;
 /// kernels when no other task can run beside them.
 pub const DENSE_PARALLEL_COLUMNS: usize = 256;
 
-/// Entries of the update buffer `W` of one thread (8 MB): a larger update goes
+/// Entries of the update buffer `W` of one thread (1 MB): a larger update goes
 /// by panels of columns.
-const W_ENTRIES: usize = 1 << 20;
+const W_ENTRIES: usize = 1 << 17;
 
 /// An update `W` of at least this many entries is scattered into `L_s` by
 /// several threads (when the supernode's `par` has them).
