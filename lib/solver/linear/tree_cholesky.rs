@@ -242,6 +242,168 @@ impl TreeCholesky {
     }
 }
 
+impl TreeCholesky {
+    /// Solves `L Lᵀ x = b` in place, `x` in the symbolic factor's (permuted)
+    /// order, with the factor `l_values` this schedule's [`TreeCholesky::factor`]
+    /// (or faer's) made: the forward substitution children before parents, each
+    /// supernode gathering the updates of its descendants; the backward one
+    /// parents before children, each supernode gathering from its ancestors. Every
+    /// supernode writes only its own columns of `x`, so independent subtrees run on
+    /// rayon's threads; the operations and their order do not depend on them.
+    pub fn solve_in_place(&self, symbolic: &SymbolicSupernodalCholesky<usize>, l_values: &[f64], x: &mut [f64]) {
+        assert_eq!(l_values.len(), symbolic.len_val(), "the value array must match the symbolic factor");
+        assert_eq!(x.len(), symbolic.nrows(), "the right-hand side must match the symbolic factor");
+        let ctx = SolveContext {
+            tree: self,
+            symbolic,
+            l_values,
+            x: SharedValues { ptr: x.as_mut_ptr(), len: x.len() },
+        };
+        let threads = rayon::current_num_threads();
+        let ctx = &ctx;
+        if threads <= 1 {
+            for s in 0..symbolic.n_supernodes() {
+                ctx.forward(s);
+            }
+            for s in (0..symbolic.n_supernodes()).rev() {
+                ctx.backward(s);
+            }
+            return;
+        }
+        rayon::scope(|scope| {
+            for &r in &self.roots {
+                scope.spawn(move |_| ctx.forward_subtree(r));
+            }
+        });
+        rayon::scope(|scope| {
+            for &r in &self.roots {
+                scope.spawn(move |_| ctx.backward_subtree(r));
+            }
+        });
+    }
+}
+
+/// What every task of one solve shares.
+struct SolveContext<'a> {
+    tree: &'a TreeCholesky,
+    symbolic: &'a SymbolicSupernodalCholesky<usize>,
+    l_values: &'a [f64],
+    x: SharedValues,
+}
+
+impl SolveContext<'_> {
+    /// Supernode `s`'s block of the factor, its column range and row pattern.
+    fn block(&self, s: usize) -> (MatRef<'_, f64>, usize, usize, &[usize]) {
+        let sym = self.symbolic;
+        let (s0, s1) = (sym.supernode_begin()[s], sym.supernode_end()[s]);
+        let row_ptr = sym.col_ptr_for_row_idx();
+        let val_ptr = sym.col_ptr_for_val();
+        let pattern = &sym.row_idx()[row_ptr[s]..row_ptr[s + 1]];
+        let l = MatRef::from_column_major_slice(&self.l_values[val_ptr[s]..val_ptr[s + 1]], s1 - s0 + pattern.len(), s1 - s0);
+        (l, s0, s1, pattern)
+    }
+
+    /// A light subtree (the factorization's task size, by flops) runs as one task.
+    fn light(&self, s: usize) -> bool {
+        self.tree.subtree_flops[s] < 4.0 * TASK_FLOPS || self.tree.children[s].is_empty()
+    }
+
+    fn forward_subtree(&self, s: usize) {
+        let tree = self.tree;
+        if self.light(s) {
+            let mut stack = vec![(s, false)];
+            while let Some((t, expanded)) = stack.pop() {
+                if expanded {
+                    self.forward(t);
+                } else {
+                    stack.push((t, true));
+                    stack.extend(tree.children[t].iter().rev().map(|&c| (c, false)));
+                }
+            }
+            return;
+        }
+        let kids = &tree.children[s];
+        rayon::scope(|scope| {
+            for &c in &kids[1..] {
+                scope.spawn(move |_| self.forward_subtree(c));
+            }
+            self.forward_subtree(kids[0]);
+        });
+        self.forward(s);
+    }
+
+    fn backward_subtree(&self, s: usize) {
+        let tree = self.tree;
+        if self.light(s) {
+            let mut stack = vec![s];
+            while let Some(t) = stack.pop() {
+                self.backward(t);
+                stack.extend(tree.children[t].iter().copied());
+            }
+            return;
+        }
+        self.backward(s);
+        let kids = &tree.children[s];
+        rayon::scope(|scope| {
+            for &c in &kids[1..] {
+                scope.spawn(move |_| self.backward_subtree(c));
+            }
+            self.backward_subtree(kids[0]);
+        });
+    }
+
+    /// `y_s ← L_s,top⁻¹ (b_s − Σ_d L_d,mid y_d)`.
+    fn forward(&self, s: usize) {
+        let (ls, s0, s1, _) = self.block(s);
+        let ncols = s1 - s0;
+        // SAFETY: x[s0..s1] is written by this task only; the descendants' entries
+        // it reads are final (module documentation, Safety, for the factor)
+        let xs = unsafe { self.x.slice_mut(s0, ncols) };
+        for &d in &self.tree.updaters[s] {
+            let (ld, d0, d1, d_pattern) = self.block(d);
+            let d_ncols = d1 - d0;
+            let p0 = d_pattern.partition_point(|&r| r < s0);
+            let mid = d_pattern[p0..].partition_point(|&r| r < s1);
+            // SAFETY: a finished descendant's entries, read only
+            let yd = unsafe { self.x.slice(d0, d_ncols) };
+            for (k, &y) in yd.iter().enumerate() {
+                let col = ld.col(k).try_as_col_major().expect("column-major").as_slice();
+                let col = &col[d_ncols + p0..d_ncols + p0 + mid];
+                for (&r, &l) in d_pattern[p0..p0 + mid].iter().zip(col) {
+                    xs[r - s0] -= l * y;
+                }
+            }
+        }
+        let top = ls.subrows(0, ncols);
+        solve_lower_triangular_in_place(top, MatMut::from_column_major_slice_mut(xs, ncols, 1), Par::Seq);
+    }
+
+    /// `x_s ← L_s,top⁻ᵀ (y_s − L_s,botᵀ x_pattern)`.
+    fn backward(&self, s: usize) {
+        let (ls, s0, s1, pattern) = self.block(s);
+        let ncols = s1 - s0;
+        // SAFETY: x[s0..s1] is written by this task only; the ancestors' entries
+        // (the pattern's rows, all ≥ s1) are final
+        let xs = unsafe { self.x.slice_mut(s0, ncols) };
+        let x_all = self.x;
+        for (k, xk) in xs.iter_mut().enumerate() {
+            let col = ls.col(k).try_as_col_major().expect("column-major").as_slice();
+            let mut acc = 0.0;
+            for (&r, &l) in pattern.iter().zip(&col[ncols..]) {
+                // SAFETY: an ancestor's entry, read only
+                acc += l * unsafe { *x_all.ptr.add(r) };
+            }
+            *xk -= acc;
+        }
+        let top = ls.subrows(0, ncols);
+        faer::linalg::triangular_solve::solve_upper_triangular_in_place(
+            top.transpose(),
+            MatMut::from_column_major_slice_mut(xs, ncols, 1),
+            Par::Seq,
+        );
+    }
+}
+
 /// What every task of one factorization shares.
 struct Context<'a> {
     tree: &'a TreeCholesky,
