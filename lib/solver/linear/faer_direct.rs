@@ -506,23 +506,6 @@ impl FaerDirect {
         let faer_err = |e: faer::dyn_stack::mem::AllocError| LinearSolverError::Faer(format!("{e:?}"));
         let x = MatMut::from_column_major_slice_mut(rhs, n, 1);
         match (&self.symbolic, &self.numeric) {
-            (Some(Symbolic::Cholesky(sym)), Numeric::Llt) if self.options.elimination_tree && self.tree.is_some() => {
-                let (Some(tree), SymbolicCholeskyRaw::Supernodal(s)) = (&self.tree, sym.raw()) else {
-                    return Err(LinearSolverError::Order("solve_in_place", "a supernodal analysis"));
-                };
-                let x = &mut *rhs;
-                match sym.perm() {
-                    Some(perm) => {
-                        let (forward, _) = perm.arrays();
-                        let mut y: Vec<f64> = forward.iter().map(|&i| x[i]).collect();
-                        tree.solve_in_place(s, &self.l_values, &mut y);
-                        for (&i, &v) in forward.iter().zip(&y) {
-                            x[i] = v;
-                        }
-                    }
-                    None => tree.solve_in_place(s, &self.l_values, x),
-                }
-            }
             (Some(Symbolic::Cholesky(sym)), Numeric::Llt) => {
                 let mut buf = MemBuffer::try_new(sym.solve_in_place_scratch::<f64>(1, par)).map_err(faer_err)?;
                 LltRef::new(sym, &self.l_values).solve_in_place_with_conj(Conj::No, x, par, MemStack::new(&mut buf));
