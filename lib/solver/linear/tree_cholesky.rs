@@ -33,9 +33,12 @@
 //!
 //! **Safety.** All supernodes write into one value array. A task writes only the
 //! block of the supernode it factors and reads only the blocks of that
-//! supernode's descendants, which were finished before it started (they belong to
-//! the same sequential range, or to a child task joined before): the blocks a
-//! thread writes are never read or written by another thread at the same time.
+//! supernode's descendants, which were finished before it started (the same task
+//! factored them before it, children before parents, or a child task that was
+//! joined before): the blocks a thread writes are never read or written by
+//! another thread at the same time. A large update's scatter splits the columns
+//! of `L_s` among threads; distinct columns of `L_d,mid` land in distinct columns
+//! of `L_s`.
 
 use std::cell::Cell;
 
