@@ -128,8 +128,12 @@ pub struct FaerDirect {
     /// Columns of the widest supernode of the Cholesky-type symbolic factor (0 for
     /// none or LU): decides the automatic parallelism ([`PARALLEL_SUPERNODE`]).
     widest_supernode: usize,
-    /// The elimination-tree schedule of the supernodal `LLᵀ` (set by `analyse`).
+    /// The elimination-tree schedule of the supernodal `LLᵀ` (set by `analyse`
+    /// when [`FaerDirectOptions::elimination_tree`]).
     tree: Option<TreeCholesky>,
+    /// Entries of the pattern's lower triangle, diagonal included (set by
+    /// `analyse`): the size of the permuted copy the tree factorization reads.
+    lower_nnz: usize,
     symbolic_time: Duration,
     numeric_time: Duration,
     n_symbolic: usize,
@@ -155,6 +159,7 @@ impl FaerDirect {
             l_values: Vec::new(),
             widest_supernode: 0,
             tree: None,
+            lower_nnz: 0,
             symbolic_time: Duration::ZERO,
             numeric_time: Duration::ZERO,
             n_symbolic: 0,
@@ -218,65 +223,62 @@ impl FaerDirect {
         let strategy = self.options.symmetric;
         let mut method = Factorization::Ldlt;
         let tree = match (&self.tree, sym.raw()) {
-            (Some(tree), SymbolicCholeskyRaw::Supernodal(s)) if self.options.elimination_tree => Some((tree, s)),
+            (Some(tree), SymbolicCholeskyRaw::Supernodal(s)) => Some((tree, s)),
             _ => None,
         };
-        if let (true, Some((tree, s))) = (strategy != SymmetricStrategy::Ldlt, tree) {
-            // the lower triangle of P A Pᵀ, as faer's own numeric factorization makes it
-            let n = sym.nrows();
-            let (cp, ri) = (pattern.col_ptr(), pattern.row_idx());
-            let nnz_lower = (0..n).map(|j| ri[cp[j]..cp[j + 1]].iter().filter(|&&i| i >= j).count()).sum::<usize>();
-            let mut new_val = vec![0.0; nnz_lower];
-            let mut new_col_ptr = vec![0usize; n + 1];
-            let mut new_row_idx = vec![0usize; nnz_lower];
-            let mut buf = MemBuffer::try_new(faer::sparse::utils::permute_self_adjoint_scratch::<usize>(n))
-                .map_err(|e| LinearSolverError::Faer(format!("{e:?}")))?;
-            let permuted;
-            let a_lower = match sym.perm() {
-                Some(perm) => {
-                    permuted = faer::sparse::utils::permute_self_adjoint_to_unsorted(
-                        &mut new_val,
-                        &mut new_col_ptr,
-                        &mut new_row_idx,
-                        a,
-                        perm,
-                        Side::Lower,
-                        Side::Lower,
-                        MemStack::new(&mut buf),
-                    );
-                    faer::reborrow::Reborrow::rb(&permuted)
-                }
-                None => a,
-            };
-            // the tasks write every block: no zeroing pass here, and the pages of a
-            // new factor are first touched in parallel (calloc'd, not written)
-            if self.l_values.len() != sym.len_val() {
-                self.l_values = vec![0.0; sym.len_val()];
-            }
-            let dense_par = self.options.par.unwrap_or_else(faer::get_global_parallelism);
-            match tree.factor(s, a_lower, &mut self.l_values, dense_par) {
-                Ok(()) => method = Factorization::Llt,
-                Err(LltError::NonPositivePivot { index }) => {
-                    if strategy == SymmetricStrategy::Llt {
-                        return Err(LinearSolverError::NotPositiveDefinite { dof: failed(index) });
+        if strategy != SymmetricStrategy::Ldlt {
+            let llt = match tree {
+                Some((tree, s)) => {
+                    // the lower triangle of P A Pᵀ, as faer's own numeric factorization makes it
+                    let (n, nnz_lower) = (sym.nrows(), self.lower_nnz);
+                    let mut new_val = vec![0.0; nnz_lower];
+                    let mut new_col_ptr = vec![0usize; n + 1];
+                    let mut new_row_idx = vec![0usize; nnz_lower];
+                    let mut buf = MemBuffer::try_new(faer::sparse::utils::permute_self_adjoint_scratch::<usize>(n))
+                        .map_err(|e| LinearSolverError::Faer(format!("{e:?}")))?;
+                    let permuted;
+                    let a_lower = match sym.perm() {
+                        Some(perm) => {
+                            permuted = faer::sparse::utils::permute_self_adjoint_to_unsorted(
+                                &mut new_val,
+                                &mut new_col_ptr,
+                                &mut new_row_idx,
+                                a,
+                                perm,
+                                Side::Lower,
+                                Side::Lower,
+                                MemStack::new(&mut buf),
+                            );
+                            faer::reborrow::Reborrow::rb(&permuted)
+                        }
+                        None => a,
+                    };
+                    // the tasks write every block: no zeroing pass here, and the pages of a
+                    // new factor are first touched in parallel (calloc'd, not written)
+                    if self.l_values.len() != sym.len_val() {
+                        self.l_values = vec![0.0; sym.len_val()];
                     }
+                    let dense_par = self.options.par.unwrap_or_else(faer::get_global_parallelism);
+                    tree.factor(s, a_lower, &mut self.l_values, dense_par)
                 }
-            }
-        } else if strategy != SymmetricStrategy::Ldlt {
-            self.l_values.resize(sym.len_val(), 0.0);
-            let mut buf = MemBuffer::try_new(sym.factorize_numeric_llt_scratch::<f64>(par, Default::default()))
-                .map_err(|e| LinearSolverError::Faer(format!("{e:?}")))?;
-            let llt = sym.factorize_numeric_llt(
-                &mut self.l_values,
-                a,
-                Side::Lower,
-                LltRegularization { dynamic_regularization_delta: 0.0, dynamic_regularization_epsilon: 0.0 },
-                par,
-                MemStack::new(&mut buf),
-                Default::default(),
-            );
+                None => {
+                    self.l_values.resize(sym.len_val(), 0.0);
+                    let mut buf = MemBuffer::try_new(sym.factorize_numeric_llt_scratch::<f64>(par, Default::default()))
+                        .map_err(|e| LinearSolverError::Faer(format!("{e:?}")))?;
+                    sym.factorize_numeric_llt(
+                        &mut self.l_values,
+                        a,
+                        Side::Lower,
+                        LltRegularization { dynamic_regularization_delta: 0.0, dynamic_regularization_epsilon: 0.0 },
+                        par,
+                        MemStack::new(&mut buf),
+                        Default::default(),
+                    )
+                    .map(|_| ())
+                }
+            };
             match llt {
-                Ok(_) => method = Factorization::Llt,
+                Ok(()) => method = Factorization::Llt,
                 Err(LltError::NonPositivePivot { index }) => {
                     if strategy == SymmetricStrategy::Llt {
                         return Err(LinearSolverError::NotPositiveDefinite { dof: failed(index) });
@@ -399,6 +401,20 @@ impl LinearSolver for FaerDirect {
                     .map_err(|e| LinearSolverError::Faer(format!("{e:?}")))?,
             ),
         };
+        self.tree = match &symbolic {
+            Symbolic::Cholesky(c) if self.options.elimination_tree => match c.raw() {
+                SymbolicCholeskyRaw::Supernodal(s) => Some(TreeCholesky::new(s)),
+                SymbolicCholeskyRaw::Simplicial(_) => None,
+            },
+            _ => None,
+        };
+        self.lower_nnz = match self.tree {
+            Some(_) => {
+                let (cp, ri) = (owned.col_ptr(), owned.row_idx());
+                (0..n).map(|j| ri[cp[j]..cp[j + 1]].iter().filter(|&&i| i >= j).count()).sum()
+            }
+            None => 0,
+        };
         self.pattern = Some(owned);
         self.widest_supernode = match &symbolic {
             Symbolic::Cholesky(c) => match c.raw() {
@@ -406,13 +422,6 @@ impl LinearSolver for FaerDirect {
                 SymbolicCholeskyRaw::Simplicial(_) => 1,
             },
             Symbolic::Lu(_) => 0,
-        };
-        self.tree = match &symbolic {
-            Symbolic::Cholesky(c) => match c.raw() {
-                SymbolicCholeskyRaw::Supernodal(s) => Some(TreeCholesky::new(s)),
-                SymbolicCholeskyRaw::Simplicial(_) => None,
-            },
-            Symbolic::Lu(_) => None,
         };
         self.symbolic = Some(symbolic);
         self.symbolic_time += start.elapsed();
@@ -484,6 +493,7 @@ impl FaerDirect {
         self.l_values = Vec::new();
         self.widest_supernode = 0;
         self.tree = None;
+        self.lower_nnz = 0;
     }
 
     /// The analysed pattern, if any.
