@@ -199,15 +199,13 @@ impl SymmetricPartGmres {
 
     /// Factor `S` of the stored values: `S[p] = (K[p] + Kᵀ[p]) / 2`.
     fn factor_symmetric(&mut self) -> Result<Factorization, LinearSolverError> {
+        let mut s = std::mem::take(&mut self.s_values);
         let vt = &self.values_t;
-        self.s_values.clear();
-        self.s_values.extend(self.transpose.iter().zip(vt).map(|(&q, at)| 0.5 * (vt[q as usize] + at)));
-        self.held = None;
-        let info = self.symmetric.factor(&self.s_values)?;
-        self.held = Some(info.method);
-        self.fresh = true;
-        self.n_numeric += 1;
-        Ok(info.method)
+        s.clear();
+        s.extend(self.transpose.iter().zip(vt).map(|(&q, at)| 0.5 * (vt[q as usize] + at)));
+        let result = self.factor_and_hold(&s);
+        self.s_values = s;
+        result
     }
 
     /// Factor `K` (the stored values) by LU, for the reason given.
@@ -251,13 +249,14 @@ impl SymmetricPartGmres {
             _ => {
                 // the copy of an earlier K goes before the factorization (peak memory)
                 self.values_t = Vec::new();
-                self.factor_tangent(values)
+                self.factor_and_hold(values)
             }
         }
     }
 
-    /// Factor the symmetric tangent `K` itself, and hold the factorization.
-    fn factor_tangent(&mut self, values: &[f64]) -> Result<Factorization, LinearSolverError> {
+    /// Factor `values` (a symmetric tangent `K` itself, or the symmetric part `S`
+    /// of a general one) and hold the factorization.
+    fn factor_and_hold(&mut self, values: &[f64]) -> Result<Factorization, LinearSolverError> {
         self.held = None;
         let info = self.symmetric.factor(values)?;
         self.held = Some(info.method);
@@ -289,7 +288,7 @@ impl SymmetricPartGmres {
             // values, the copy, go with it)
             let t = Instant::now();
             let k = std::mem::take(&mut self.values_t);
-            let refactored = self.factor_tangent(&k);
+            let refactored = self.factor_and_hold(&k);
             drop(k);
             self.numeric_time += t.elapsed();
             refactored.and_then(|_| {
