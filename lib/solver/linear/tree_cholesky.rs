@@ -85,8 +85,6 @@ pub struct TreeCholesky {
     /// `updaters[s]`: the descendants `d` whose row pattern meets the columns of
     /// `s`, increasing.
     updaters: Vec<Vec<usize>>,
-    /// Total flops.
-    flops: f64,
 }
 
 /// The raw value array shared by the tasks (see the module's **Safety**).
@@ -188,19 +186,19 @@ impl TreeCholesky {
                 subtree_flops[s] += f;
             }
         }
-        let flops = roots.iter().map(|&r| subtree_flops[r]).sum();
-        Self { children, roots, subtree_flops, updaters, flops }
+        Self { children, roots, subtree_flops, updaters }
     }
 
-    /// Flops of one numeric factorization (multiply and add counted apart).
-    pub fn flops(&self) -> f64 {
-        self.flops
+    /// Whether the subtree of `s` runs as one sequential task: it is light, or a
+    /// leaf.
+    fn light(&self, s: usize) -> bool {
+        self.subtree_flops[s] < TASK_FLOPS || self.children[s].is_empty()
     }
 
     /// How many subtrees the schedule hands to separate tasks (the children of
     /// every supernode that is split; 0: the factorization runs as one task).
     pub fn parallel_subtrees(&self) -> usize {
-        let split = |s: usize| self.subtree_flops[s] >= TASK_FLOPS && self.children[s].len() > 1;
+        let split = |s: usize| !self.light(s) && self.children[s].len() > 1;
         let tops = if self.roots.len() > 1 { self.roots.len() } else { 0 };
         tops + (0..self.children.len()).filter(|&s| split(s)).map(|s| self.children[s].len()).sum::<usize>()
     }
@@ -258,14 +256,22 @@ struct Context<'a> {
 }
 
 impl Context<'_> {
-    /// Factors the subtree of `s`: sequentially if it is small or a chain,
-    /// otherwise its children's subtrees in parallel, then `s`.
+    /// Factors the subtree of `s`: sequentially if it is light; otherwise down its
+    /// chain of only children (a loop, not a recursion: chains can be long) to the
+    /// first supernode that is light or has several children, whose children's
+    /// subtrees run in parallel; then the chain back up.
     fn subtree(&self, s: usize) {
         let tree = self.tree;
-        let kids = &tree.children[s];
-        if tree.subtree_flops[s] < TASK_FLOPS || kids.is_empty() {
-            // children before parents, without recursion (chains can be long)
-            let mut stack = vec![(s, false)];
+        let mut chain = vec![s];
+        let mut bottom = s;
+        while !tree.light(bottom) && tree.children[bottom].len() == 1 {
+            bottom = tree.children[bottom][0];
+            chain.push(bottom);
+        }
+        if tree.light(bottom) {
+            chain.pop();
+            // children before parents, without recursion
+            let mut stack = vec![(bottom, false)];
             while let Some((t, expanded)) = stack.pop() {
                 if expanded {
                     self.supernode(t, Par::Seq);
@@ -274,11 +280,8 @@ impl Context<'_> {
                     stack.extend(tree.children[t].iter().rev().map(|&c| (c, false)));
                 }
             }
-            return;
-        }
-        if kids.len() == 1 {
-            self.subtree(kids[0]);
         } else {
+            let kids = &tree.children[bottom];
             rayon::scope(|scope| {
                 for &c in &kids[1..] {
                     scope.spawn(move |_| self.subtree(c));
@@ -286,8 +289,10 @@ impl Context<'_> {
                 self.subtree(kids[0]);
             });
         }
-        let ncols = self.symbolic.supernode_end()[s] - self.symbolic.supernode_begin()[s];
-        self.supernode(s, if ncols >= DENSE_PARALLEL_COLUMNS { self.par } else { Par::Seq });
+        let (begin, end) = (self.symbolic.supernode_begin(), self.symbolic.supernode_end());
+        for &t in chain.iter().rev() {
+            self.supernode(t, if end[t] - begin[t] >= DENSE_PARALLEL_COLUMNS { self.par } else { Par::Seq });
+        }
     }
 
     /// Steps 1–3 of the module's algorithm for supernode `s`.
@@ -349,13 +354,13 @@ impl Context<'_> {
                 let width = (self.w_entries / low.max(1)).max(32).min(mid.max(1));
                 for j0 in (0..mid).step_by(width) {
                     let j1 = (j0 + width).min(mid);
-                    let (cols, rows) = (j1 - j0, low - j0);
-                    if buffer.len() < rows * cols {
-                        buffer.resize(rows * cols, 0.0);
+                    let (w_cols, w_rows) = (j1 - j0, low - j0);
+                    if buffer.len() < w_rows * w_cols {
+                        buffer.resize(w_rows * w_cols, 0.0);
                     }
-                    let mut w = MatMut::from_column_major_slice_mut(&mut buffer[..rows * cols], rows, cols);
-                    let panel = ld_mid.subrows(j0, cols);
-                    let (w_top, w_bot) = w.rb_mut().split_at_row_mut(cols);
+                    let mut w = MatMut::from_column_major_slice_mut(&mut buffer[..w_rows * w_cols], w_rows, w_cols);
+                    let panel = ld_mid.subrows(j0, w_cols);
+                    let (w_top, w_bot) = w.rb_mut().split_at_row_mut(w_cols);
                     triangular::matmul(
                         w_top,
                         BlockStructure::TriangularLower,
@@ -372,7 +377,7 @@ impl Context<'_> {
                     let map = &map[j0..];
                     let scatter = |jj: usize, dst: &mut [f64]| {
                         let w_col = w.col(jj).try_as_col_major().expect("W is column-major").as_slice();
-                        for ii in jj..rows {
+                        for ii in jj..w_rows {
                             dst[map[ii]] -= w_col[ii];
                         }
                     };
@@ -380,10 +385,10 @@ impl Context<'_> {
                     // d_pattern[p0 + j] − s₀ are distinct for distinct j: each call
                     // writes its own column
                     let column = |jj: usize| unsafe { ls_cols.slice_mut((d_pattern[p0 + j0 + jj] - s0) * s_nrows, s_nrows) };
-                    if matches!(par, Par::Rayon(_)) && rows * cols >= PARALLEL_SCATTER {
-                        (0..cols).into_par_iter().for_each(|jj| scatter(jj, column(jj)));
+                    if matches!(par, Par::Rayon(_)) && w_rows * w_cols >= PARALLEL_SCATTER {
+                        (0..w_cols).into_par_iter().for_each(|jj| scatter(jj, column(jj)));
                     } else {
-                        for jj in 0..cols {
+                        for jj in 0..w_cols {
                             scatter(jj, column(jj));
                         }
                     }
@@ -425,11 +430,78 @@ mod tests {
     use super::*;
     use crate::solver::bench::{elastic_cube_system, relative_residual};
     use crate::solver::linear::{FaerDirect, FaerDirectOptions, LinearSolver, LinearSolverError, SymmetricStrategy, Symmetry};
-    use faer::sparse::linalg::cholesky::SymbolicCholeskyRaw;
-    use faer::sparse::SymbolicSparseColMat;
+    use crate::solver::ordering::nested_dissection;
+    use faer::perm::PermRef;
+    use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, CholeskySymbolicParams, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering};
+    use faer::sparse::linalg::SupernodalThreshold;
+    use faer::sparse::{SymbolicSparseColMat, SymbolicSparseColMatRef};
+    use faer::Side;
 
-    fn solve(options: FaerDirectOptions, p: &SymbolicSparseColMat<usize>, v: &[f64], b: &[f64], threads: usize) -> Result<Vec<f64>, LinearSolverError> {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("a thread pool");
+    /// A symmetric matrix (both triangles stored), its supernodal symbolic factor
+    /// (METIS ordering, as `FaerDirect` makes it) and the lower triangle of `P A Pᵀ`.
+    struct Problem {
+        p: SymbolicSparseColMat<usize>,
+        v: Vec<f64>,
+        sym: SymbolicCholesky<usize>,
+        lower: (Vec<usize>, Vec<usize>, Vec<f64>),
+    }
+
+    impl Problem {
+        fn new(p: SymbolicSparseColMat<usize>, v: Vec<f64>) -> Self {
+            let order = nested_dissection(p.as_ref()).unwrap();
+            let n = p.nrows();
+            let params = CholeskySymbolicParams { supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL, ..Default::default() };
+            let ordering = SymmetricOrdering::Custom(PermRef::new_checked(&order.forward, &order.inverse, n));
+            let sym = factorize_symbolic_cholesky(p.as_ref(), Side::Lower, ordering, params).unwrap();
+            let nnz = p.row_idx().len();
+            let (mut cp, mut ri, mut val) = (vec![0usize; n + 1], vec![0usize; nnz], vec![0.0; nnz]);
+            let mut buf = MemBuffer::new(faer::sparse::utils::permute_self_adjoint_scratch::<usize>(n));
+            let a = SparseColMatRef::new(p.as_ref(), &v);
+            let perm = sym.perm().expect("a fill-reducing permutation");
+            faer::sparse::utils::permute_self_adjoint_to_unsorted(&mut val, &mut cp, &mut ri, a, perm, Side::Lower, Side::Lower, MemStack::new(&mut buf));
+            let used = cp[n];
+            ri.truncate(used);
+            val.truncate(used);
+            Self { p, v, sym, lower: (cp, ri, val) }
+        }
+
+        fn supernodal(&self) -> &SymbolicSupernodalCholesky<usize> {
+            match self.sym.raw() {
+                SymbolicCholeskyRaw::Supernodal(s) => s,
+                SymbolicCholeskyRaw::Simplicial(_) => panic!("a supernodal factor"),
+            }
+        }
+
+        /// The tree factorization's values, on `threads` rayon threads.
+        fn tree_factor(&self, threads: usize, par: Par) -> Result<Vec<f64>, LltError> {
+            let s = self.supernodal();
+            let (cp, ri, val) = &self.lower;
+            let n = self.p.nrows();
+            let a_lower = SparseColMatRef::new(SymbolicSparseColMatRef::new_unsorted_checked(n, n, cp, None, ri), val);
+            let mut l = vec![0.0; s.len_val()];
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("a thread pool");
+            pool.install(|| TreeCholesky::new(s).factor(s, a_lower, &mut l, par))?;
+            Ok(l)
+        }
+
+        /// faer's own numeric factorization's values.
+        fn faer_factor(&self) -> Result<Vec<f64>, LltError> {
+            let mut l = vec![0.0; self.sym.len_val()];
+            let mut buf = MemBuffer::new(self.sym.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()));
+            let regularization = LltRegularization { dynamic_regularization_delta: 0.0, dynamic_regularization_epsilon: 0.0 };
+            let a = SparseColMatRef::new(self.p.as_ref(), &self.v);
+            self.sym.factorize_numeric_llt(&mut l, a, Side::Lower, regularization, Par::Seq, MemStack::new(&mut buf), Default::default())?;
+            Ok(l)
+        }
+    }
+
+    fn cube(n: usize) -> Problem {
+        let cube = elastic_cube_system(n).unwrap();
+        Problem::new(cube.pattern.symbolic_owned().clone(), cube.assembly.values().to_vec())
+    }
+
+    fn solve(options: FaerDirectOptions, p: &SymbolicSparseColMat<usize>, v: &[f64], b: &[f64]) -> Result<Vec<f64>, LinearSolverError> {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().expect("a thread pool");
         pool.install(|| {
             let mut s = FaerDirect::new(options);
             s.analyse(p.as_ref(), Symmetry::Symmetric)?;
@@ -440,76 +512,61 @@ mod tests {
         })
     }
 
-    fn tree(on: bool) -> FaerDirectOptions {
-        FaerDirectOptions { elimination_tree: on, ..Default::default() }
-    }
-
     #[test]
-    fn the_tree_factor_solves_as_faers_own_does() {
-        let cube = elastic_cube_system(10).unwrap();
-        let (p, v, b) = (cube.pattern.symbolic_owned(), cube.assembly.values(), &cube.rhs);
+    fn the_tree_factor_is_faers_own_to_round_off() {
+        let pb = cube(10);
         // the schedule really splits this factor into parallel subtrees
-        let sym = faer::sparse::linalg::cholesky::factorize_symbolic_cholesky(
-            p.as_ref(),
-            faer::Side::Lower,
-            faer::sparse::linalg::cholesky::SymmetricOrdering::Custom(faer::perm::PermRef::new_checked(
-                &crate::solver::ordering::nested_dissection(p.as_ref()).unwrap().forward,
-                &crate::solver::ordering::nested_dissection(p.as_ref()).unwrap().inverse,
-                p.nrows(),
-            )),
-            faer::sparse::linalg::cholesky::CholeskySymbolicParams {
-                supernodal_flop_ratio_threshold: faer::sparse::linalg::SupernodalThreshold::FORCE_SUPERNODAL,
-                ..Default::default()
-            },
-        )
-        .unwrap();
-        let SymbolicCholeskyRaw::Supernodal(s) = sym.raw() else { panic!("a supernodal factor") };
-        let schedule = TreeCholesky::new(s);
+        let schedule = TreeCholesky::new(pb.supernodal());
         assert!(schedule.parallel_subtrees() >= 4, "{} parallel subtrees", schedule.parallel_subtrees());
-        let x_faer = solve(tree(false), p, v, b, 2).unwrap();
-        let x_tree = solve(tree(true), p, v, b, 2).unwrap();
-        let r = relative_residual(p.col_ptr(), p.row_idx(), v, &x_tree, b);
+        // the same factor entry by entry: the same operations in another order
+        // (an update through a buffer, faer's fused into its product); the cube's
+        // condition number is ~1e4, so 1e-16 · 1e4 with room
+        let faer_l = pb.faer_factor().unwrap();
+        let tree_l = pb.tree_factor(2, Par::rayon(2)).unwrap();
+        let scale = faer_l.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let d = tree_l.iter().zip(&faer_l).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        assert!(d <= 1e-11 * scale, "factors differ by {:e} of the largest entry", d / scale);
+        // and FaerDirect, which uses it by default, solves with it
+        let b: Vec<f64> = (0..pb.p.nrows()).map(|i| ((i % 13) as f64 - 6.0) / 6.0).collect();
+        let x = solve(FaerDirectOptions::default(), &pb.p, &pb.v, &b).unwrap();
+        let r = relative_residual(pb.p.col_ptr(), pb.p.row_idx(), &pb.v, &x, &b);
         assert!(r < 1e-12, "residual {r:e}");
-        // the same operations in another order: the two differ by round-off only
-        // (the cube's condition number is ~1e4: 1e-16 · 1e4 with room)
-        let norm = x_faer.iter().map(|v| v * v).sum::<f64>().sqrt();
-        let d = x_tree.iter().zip(&x_faer).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt();
-        assert!(d / norm < 1e-11, "solutions differ by {:e}", d / norm);
     }
 
     #[test]
     fn the_tree_factor_is_the_same_for_any_number_of_threads() {
-        let cube = elastic_cube_system(10).unwrap();
-        let (p, v, b) = (cube.pattern.symbolic_owned(), cube.assembly.values(), &cube.rhs);
+        let pb = cube(10);
         // the dense kernels sequential: only the tree runs in parallel
-        let options = FaerDirectOptions { par: Some(Par::Seq), ..tree(true) };
-        let bits = |x: Vec<f64>| x.into_iter().map(f64::to_bits).collect::<Vec<_>>();
-        let one = bits(solve(options, p, v, b, 1).unwrap());
+        let bits = |l: Vec<f64>| l.into_iter().map(f64::to_bits).collect::<Vec<_>>();
+        let one = bits(pb.tree_factor(1, Par::Seq).unwrap());
         for threads in [2, 3] {
-            assert_eq!(one, bits(solve(options, p, v, b, threads).unwrap()), "{threads} threads");
+            assert_eq!(one, bits(pb.tree_factor(threads, Par::Seq).unwrap()), "{threads} threads");
         }
     }
 
     #[test]
     fn a_non_positive_pivot_is_reported_where_faer_reports_it() {
-        let cube = elastic_cube_system(8).unwrap();
-        let (p, b) = (cube.pattern.symbolic_owned(), &cube.rhs);
-        let mut v = cube.assembly.values().to_vec();
+        let mut pb = cube(8);
         // an indefinite matrix: one diagonal entry in the middle of the cube negated
-        let j = p.ncols() / 2;
-        let k = (p.col_ptr()[j]..p.col_ptr()[j + 1]).find(|&k| p.row_idx()[k] == j).unwrap();
-        v[k] = -v[k];
-        let llt_only = |on: bool| FaerDirectOptions { symmetric: SymmetricStrategy::Llt, ..tree(on) };
-        let dof = |r: Result<Vec<f64>, LinearSolverError>| match r {
-            Err(LinearSolverError::NotPositiveDefinite { dof }) => dof,
-            other => panic!("expected a non-positive pivot, got {:?}", other.map(|x| x.len())),
+        let j = pb.p.ncols() / 2;
+        let k = (pb.p.col_ptr()[j]..pb.p.col_ptr()[j + 1]).find(|&k| pb.p.row_idx()[k] == j).unwrap();
+        pb.v[k] = -pb.v[k];
+        let pb = Problem::new(pb.p, pb.v);
+        let index = |r: Result<Vec<f64>, LltError>| match r {
+            Err(LltError::NonPositivePivot { index }) => index,
+            Ok(_) => panic!("expected a non-positive pivot"),
         };
-        let faer_dof = dof(solve(llt_only(false), p, &v, b, 2));
-        assert_eq!(dof(solve(llt_only(true), p, &v, b, 2)), faer_dof);
-        assert_eq!(dof(solve(llt_only(true), p, &v, b, 1)), faer_dof);
-        // and the default strategy goes on to LDLᵀ, which solves it
-        let x = solve(tree(true), p, &v, b, 2).unwrap();
-        let r = relative_residual(p.col_ptr(), p.row_idx(), &v, &x, b);
+        let faer_index = index(pb.faer_factor());
+        assert_eq!(index(pb.tree_factor(2, Par::rayon(2))), faer_index);
+        assert_eq!(index(pb.tree_factor(1, Par::Seq)), faer_index);
+        // FaerDirect reports it with its dof under `Llt`, and its default strategy
+        // goes on to LDLᵀ, which solves it
+        let b: Vec<f64> = (0..pb.p.nrows()).map(|i| ((i % 13) as f64 - 6.0) / 6.0).collect();
+        let llt_only = FaerDirectOptions { symmetric: SymmetricStrategy::Llt, ..Default::default() };
+        let dof = pb.sym.perm().unwrap().arrays().0[faer_index];
+        assert!(matches!(solve(llt_only, &pb.p, &pb.v, &b), Err(LinearSolverError::NotPositiveDefinite { dof: d }) if d == dof));
+        let x = solve(FaerDirectOptions::default(), &pb.p, &pb.v, &b).unwrap();
+        let r = relative_residual(pb.p.col_ptr(), pb.p.row_idx(), &pb.v, &x, &b);
         assert!(r < 1e-10, "residual {r:e}");
     }
 }
