@@ -269,3 +269,23 @@ fn fixed_parallelism_is_reproducible() {
     assert_eq!(bits(run(Par::Seq)), bits(run(Par::Seq)));
     assert_eq!(bits(run(Par::rayon(2))), bits(run(Par::rayon(2))));
 }
+
+/// `FaerDirect`'s `LLᵀ` is the elimination-tree factorization by default, and
+/// faer's own with `elimination_tree: false`. With sequential dense kernels the
+/// two compute every entry by the same operations in the same order: the same
+/// factor, bit for bit (`docs/theory/solver.md`).
+#[test]
+fn the_elimination_tree_factor_is_faers_own_bit_for_bit_with_sequential_kernels() {
+    let cube = elastic_cube_system(10).unwrap();
+    let p = cube.pattern.symbolic_owned();
+    let factor = |elimination_tree: bool| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+        let mut s = FaerDirect::new(FaerDirectOptions { par: Some(Par::Seq), elimination_tree, ..Default::default() });
+        s.analyse(p.as_ref(), Symmetry::Symmetric).unwrap();
+        assert_eq!(pool.install(|| s.factor(cube.assembly.values())).unwrap().method, Factorization::Llt);
+        assert_eq!(s.tree.is_some(), elimination_tree);
+        s.l_values
+    };
+    let bits = |l: Vec<f64>| l.into_iter().map(f64::to_bits).collect::<Vec<_>>();
+    assert_eq!(bits(factor(true)), bits(factor(false)));
+}
