@@ -166,83 +166,115 @@ impl Pattern {
             })
             .collect();
 
-        // Free rows of the columns of node a: free dofs of its neighbours, in
-        // increasing order (free numbering is monotone in the global dof).
-        let free_rows_of_node = |a: usize, out: &mut Vec<usize>| {
-            out.clear();
-            for &b in &neighbours[a] {
-                for c in 0..DOFS_PER_NODE {
-                    if let Some(f) = dofs.free(DOFS_PER_NODE * b as usize + c) {
-                        out.push(f);
-                    }
-                }
-            }
-        };
-
+        // The columns of node a's free dofs all hold the same rows: the free dofs of
+        // its neighbours, in increasing order (the free numbering is monotone in the
+        // global dof). Counted per node first, so that the columns are filled in
+        // parallel into arrays of their final size.
+        let free_of = |a: usize| (0..DOFS_PER_NODE).filter(|&c| !dofs.is_constrained(DOFS_PER_NODE * a + c)).count();
+        let rows_of_node: Vec<usize> = neighbours.par_iter().map(|nb| nb.iter().map(|&b| free_of(b as usize)).sum()).collect();
         let n_free = dofs.n_free();
         let mut col_ptr = Vec::with_capacity(n_free + 1);
         col_ptr.push(0usize);
-        let mut row_idx: Vec<usize> = Vec::new();
-        let mut rows = Vec::new();
+        // where the first column of each node starts in row_idx
+        let mut node_start = Vec::with_capacity(n_nodes + 1);
+        let mut nnz = 0usize;
         for a in 0..n_nodes {
-            let n_free_comps =
-                (0..DOFS_PER_NODE).filter(|&c| !dofs.is_constrained(DOFS_PER_NODE * a + c)).count();
-            if n_free_comps == 0 {
-                continue;
-            }
-            free_rows_of_node(a, &mut rows);
-            for c in 0..DOFS_PER_NODE {
-                if !dofs.is_constrained(DOFS_PER_NODE * a + c) {
-                    row_idx.extend_from_slice(&rows);
-                    col_ptr.push(row_idx.len());
-                }
+            node_start.push(nnz);
+            for _ in 0..free_of(a) {
+                nnz += rows_of_node[a];
+                col_ptr.push(nnz);
             }
         }
+        node_start.push(nnz);
         debug_assert_eq!(col_ptr.len(), n_free + 1);
-        let nnz = row_idx.len();
         if nnz >= NO_SLOT as usize {
             return Err(PatternError::TooManyEntries { nnz });
         }
+        let mut row_idx = vec![0usize; nnz];
+        let mut node_rows: Vec<&mut [usize]> = Vec::with_capacity(n_nodes);
+        let mut rest = &mut row_idx[..];
+        for a in 0..n_nodes {
+            let (this, tail) = rest.split_at_mut(node_start[a + 1] - node_start[a]);
+            node_rows.push(this);
+            rest = tail;
+        }
+        node_rows.into_par_iter().enumerate().for_each(|(a, out)| {
+            let n_rows = rows_of_node[a];
+            if out.is_empty() {
+                return; // no free dof: no column
+            }
+            let mut k = 0;
+            for &b in &neighbours[a] {
+                for c in 0..DOFS_PER_NODE {
+                    if let Some(f) = dofs.free(DOFS_PER_NODE * b as usize + c) {
+                        out[k] = f;
+                        k += 1;
+                    }
+                }
+            }
+            // the node's other free columns repeat its first
+            let (first, others) = out.split_at_mut(n_rows.min(out.len()));
+            for column in others.chunks_exact_mut(n_rows.max(1)) {
+                column.copy_from_slice(first);
+            }
+        });
 
-        // Slots of an element's entries. Node blocks are stored whole and the free
-        // numbering is monotone in the global dof, so the free components of one row
-        // node sit in consecutive positions of every column that couples it: one
-        // binary search per (row node, column), not per entry.
-        let element_slots = |nodes: &[u32], out: &mut [u32]| {
+        // Slots of an element's entries. Node blocks are stored whole, the free
+        // components of one row node sit in consecutive positions of every column
+        // that couples it, and the free columns of one node hold the same rows: one
+        // binary search per (column node, row node), not per entry.
+        // `offset[r]`: position of row node r's first free dof within the columns of
+        // the column node, or `NO_SLOT` for a node without free dofs.
+        let element_slots = |nodes: &[u32], out: &mut [u32], offset: &mut Vec<u32>| {
             let nd = DOFS_PER_NODE * nodes.len();
-            for (j, col) in out.chunks_exact_mut(nd).enumerate() {
-                let Some(fj) = dofs.free(DOFS_PER_NODE * nodes[j / DOFS_PER_NODE] as usize + j % DOFS_PER_NODE) else {
-                    col.fill(NO_SLOT);
+            for (block, &a) in out.chunks_exact_mut(DOFS_PER_NODE * nd).zip(nodes) {
+                let base = DOFS_PER_NODE * a as usize;
+                let Some(f0) = (0..DOFS_PER_NODE).find_map(|c| dofs.free(base + c)) else {
+                    block.fill(NO_SLOT);
                     continue;
                 };
-                let (lo, hi) = (col_ptr[fj], col_ptr[fj + 1]);
-                for (&a, block) in nodes.iter().zip(col.chunks_exact_mut(DOFS_PER_NODE)) {
-                    let base = DOFS_PER_NODE * a as usize;
-                    let Some(first) = (0..DOFS_PER_NODE).find_map(|c| dofs.free(base + c)) else {
-                        block.fill(NO_SLOT);
+                let rows = &row_idx[col_ptr[f0]..col_ptr[f0 + 1]];
+                offset.clear();
+                offset.extend(nodes.iter().map(|&b| {
+                    let base_b = DOFS_PER_NODE * b as usize;
+                    (0..DOFS_PER_NODE).find_map(|c| dofs.free(base_b + c)).map_or(NO_SLOT, |first| match rows.binary_search(&first) {
+                        Ok(k) => k as u32,
+                        Err(_) => unreachable!("coupled dofs are in the pattern by construction"),
+                    })
+                }));
+                for (c, col) in block.chunks_exact_mut(nd).enumerate() {
+                    let Some(fj) = dofs.free(base + c) else {
+                        col.fill(NO_SLOT);
                         continue;
                     };
-                    let mut at = match row_idx[lo..hi].binary_search(&first) {
-                        Ok(k) => lo + k,
-                        Err(_) => unreachable!("coupled dofs are in the pattern by construction"),
-                    };
-                    for (c, slot) in block.iter_mut().enumerate() {
-                        *slot = if dofs.is_constrained(base + c) {
-                            NO_SLOT
-                        } else {
-                            at += 1;
-                            (at - 1) as u32
-                        };
+                    let start = col_ptr[fj];
+                    for ((&b, &k), rows) in nodes.iter().zip(offset.iter()).zip(col.chunks_exact_mut(DOFS_PER_NODE)) {
+                        if k == NO_SLOT {
+                            rows.fill(NO_SLOT);
+                            continue;
+                        }
+                        let base_b = DOFS_PER_NODE * b as usize;
+                        let mut at = start + k as usize;
+                        for (cb, slot) in rows.iter_mut().enumerate() {
+                            *slot = if dofs.is_constrained(base_b + cb) {
+                                NO_SLOT
+                            } else {
+                                at += 1;
+                                (at - 1) as u32
+                            };
+                        }
                     }
                 }
             }
         };
 
-        let mut hex_slots = vec![NO_SLOT; hexes.len() * HEX_ENTRIES];
+        // zeroed (calloc'd pages, first touched by the tasks that write them): every
+        // entry is written below
+        let mut hex_slots = vec![0u32; hexes.len() * HEX_ENTRIES];
         hex_slots
             .par_chunks_mut(HEX_ENTRIES)
             .zip(hexes.par_iter())
-            .for_each(|(out, hex)| element_slots(hex, out));
+            .for_each_init(Vec::new, |offset, (out, hex)| element_slots(hex, out, offset));
 
         let mut group_slot_offsets = Vec::with_capacity(groups.len() + 1);
         group_slot_offsets.push(0usize);
@@ -250,7 +282,7 @@ impl Pattern {
             let nd = DOFS_PER_NODE * nodes.len();
             group_slot_offsets.push(group_slot_offsets[group_slot_offsets.len() - 1] + nd * nd);
         }
-        let mut group_slots = vec![NO_SLOT; group_slot_offsets[groups.len()]];
+        let mut group_slots = vec![0u32; group_slot_offsets[groups.len()]];
         let mut outs = Vec::with_capacity(groups.len());
         let mut rest = &mut group_slots[..];
         for g in 0..groups.len() {
@@ -258,7 +290,7 @@ impl Pattern {
             outs.push(out);
             rest = tail;
         }
-        outs.into_par_iter().enumerate().for_each(|(g, out)| element_slots(groups.group(g), out));
+        outs.into_par_iter().enumerate().for_each_init(Vec::new, |offset, (g, out)| element_slots(groups.group(g), out, offset));
 
         let symbolic = SymbolicSparseColMat::new_checked(n_free, n_free, col_ptr, None, row_idx);
         let colouring = colouring.unwrap_or_else(|| Colouring::greedy(n_nodes, hexes.iter().map(|h| &h[..])));
