@@ -178,10 +178,10 @@ impl Pattern {
         // where the first column of each node starts in row_idx
         let mut node_start = Vec::with_capacity(n_nodes + 1);
         let mut nnz = 0usize;
-        for a in 0..n_nodes {
+        for (a, &rows) in rows_of_node.iter().enumerate() {
             node_start.push(nnz);
             for _ in 0..free_of(a) {
-                nnz += rows_of_node[a];
+                nnz += rows;
                 col_ptr.push(nnz);
             }
         }

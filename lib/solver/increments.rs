@@ -10,7 +10,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use super::log::{IterationEvent, SolveLog};
-use super::newton::{gauss_stresses, IncrementFailure, Newton};
+use super::newton::{gauss_stresses, IncrementFailure, Newton, SetupFailure};
 use super::uzawa::solve_augmented;
 use crate::contact::pair::SlaveStatus;
 use crate::format::sccontact::MasterKind;
@@ -42,6 +42,9 @@ pub enum SolveError {
     },
     #[error(transparent)]
     Write(#[from] StageError),
+    /// The solver's setup failed when it was completed (the first analysis).
+    #[error(transparent)]
+    Setup(#[from] SetupFailure),
     #[error("{file}: resuming from its increment at load factor {load_factor:.6}: {failure}")]
     Resume { file: String, load_factor: f64, failure: IncrementFailure },
 }
@@ -351,6 +354,7 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
                     }
                     lambda = target;
                 }
+                Err(IncrementFailure::Setup { error }) => return Err(SolveError::Setup(SetupFailure::Linear(error))),
                 Err(failure) => {
                     for pair in &mut newton.contact {
                         pair.restore();

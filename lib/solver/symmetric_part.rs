@@ -330,16 +330,9 @@ pub fn transpose_positions(pattern: SymbolicSparseColMatRef<'_, usize>) -> Optio
     Some(transpose)
 }
 
-impl LinearSolver for SymmetricPartGmres {
-    fn name(&self) -> &str {
-        if self.symmetric_tangent {
-            "faer-cholesky-kept"
-        } else {
-            "faer-symmetric-part-gmres"
-        }
-    }
-
-    fn analyse(&mut self, pattern: SymbolicSparseColMatRef<'_, usize>, symmetry: Symmetry) -> Result<(), LinearSolverError> {
+impl SymmetricPartGmres {
+    /// `analyse`, the symmetric part's analysis in the background when `background`.
+    fn analyse_with(&mut self, pattern: SymbolicSparseColMatRef<'_, usize>, symmetry: Symmetry, background: bool) -> Result<(), LinearSolverError> {
         let start = Instant::now();
         self.analysed = false;
         self.held = None;
@@ -360,7 +353,11 @@ impl LinearSolver for SymmetricPartGmres {
             self.lu.analyse(pattern, Symmetry::General)?;
             self.lu_analysed = true;
         } else {
-            self.symmetric.analyse(pattern, Symmetry::Symmetric)?;
+            if background {
+                self.symmetric.analyse_in_background(pattern, Symmetry::Symmetric)?;
+            } else {
+                self.symmetric.analyse(pattern, Symmetry::Symmetric)?;
+            }
         }
         self.analysed = true;
         self.symbolic_time += start.elapsed();
@@ -368,7 +365,38 @@ impl LinearSolver for SymmetricPartGmres {
         Ok(())
     }
 
+}
+
+impl LinearSolver for SymmetricPartGmres {
+    fn name(&self) -> &str {
+        if self.symmetric_tangent {
+            "faer-cholesky-kept"
+        } else {
+            "faer-symmetric-part-gmres"
+        }
+    }
+
+    fn analyse(&mut self, pattern: SymbolicSparseColMatRef<'_, usize>, symmetry: Symmetry) -> Result<(), LinearSolverError> {
+        self.analyse_with(pattern, symmetry, false)
+    }
+
+    /// The symmetric part's analysis (when the pattern is structurally symmetric)
+    /// runs in the background as [`FaerDirect`]'s does; the LU's, when the pattern is
+    /// not, here.
+    fn analyse_in_background(&mut self, pattern: SymbolicSparseColMatRef<'_, usize>, symmetry: Symmetry) -> Result<(), LinearSolverError> {
+        self.analyse_with(pattern, symmetry, true)
+    }
+
+    fn finish_analysis(&mut self) -> Result<(), LinearSolverError> {
+        // the background thread's time joins this solver's analysis time
+        let before = self.symmetric.timings().symbolic;
+        self.symmetric.finish_analysis()?;
+        self.symbolic_time += self.symmetric.timings().symbolic.saturating_sub(before);
+        Ok(())
+    }
+
     fn factor(&mut self, values: &[f64]) -> Result<FactorInfo, LinearSolverError> {
+        self.finish_analysis()?;
         let nnz = check_values(self.pattern(), values)?.row_idx().len();
         let start = Instant::now();
         self.lu_reason = None;
@@ -410,6 +438,7 @@ impl LinearSolver for SymmetricPartGmres {
     }
 
     fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolverError> {
+        self.finish_analysis()?;
         let Some(pattern) = self.pattern() else {
             return Err(LinearSolverError::Order("solve_in_place", "analyse"));
         };

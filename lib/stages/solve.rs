@@ -211,6 +211,12 @@ pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, 
     if !newton.contact.is_empty() {
         log.line(&format!("contact: the sparsity pattern was rebuilt {} times as contact elements changed", newton.pattern_rebuilds));
     }
+    let (checks, misses) = newton.residual_first;
+    if checks > 0 {
+        log.line(&format!(
+            "assembly: {checks} iterates assembled residual first, where Newton's rate predicted convergence; {misses} of them took the tangent after (newton.residual_first)"
+        ));
+    }
     let t = newton.linear_timings();
     log.line(&format!(
         "linear solver {}: {} analyses {:.2} s, {} factorizations {:.2} s, {} solves {:.2} s{}",

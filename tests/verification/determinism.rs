@@ -67,3 +67,47 @@ fn only_the_wall_clock_times_differ_by_default() {
     };
     assert_eq!(dump(&a["crossed_beams.scres"]), dump(&b["crossed_beams.scres"]));
 }
+
+/// `newton.residual_first` (on by default) changes the cost of an iterate, not its
+/// numbers: the shipped crossed beams, whose augmented-Lagrangian solves converge
+/// quadratically, check several converged iterates by their residual alone, and
+/// every displacement, multiplier, friction state, reaction and residual in the
+/// results equals, bit for bit, that of the same run with it off.
+#[test]
+fn the_residual_first_check_changes_no_number() {
+    let dir = staged_pipeline("crossed_beams", &["crossed_beams.msh"]);
+    let run = |residual_first: bool| {
+        let yaml = dir.path().join("pipelines/crossed_beams.yaml");
+        let text = std::fs::read_to_string(&yaml).unwrap();
+        let newton = "newton: {max_iterations: 25, residual_tolerance: 1.0e-8, energy_tolerance: 1.0e-12";
+        assert!(text.contains(newton), "the shipped pipeline's newton line changed");
+        let set = format!("{newton}, residual_first: {residual_first}");
+        let patched = text.replace(&format!("{newton}, residual_first: true"), newton).replace(&format!("{newton}, residual_first: false"), newton).replace(newton, &set);
+        std::fs::write(&yaml, patched).unwrap();
+        let out = dir.path().join("pipelines/out");
+        let _ = std::fs::remove_dir_all(&out);
+        let o = Command::new(env!("CARGO_BIN_EXE_sc-pipeline")).args(["pipelines/crossed_beams.yaml"]).current_dir(dir.path()).env("SC_REPRODUCIBLE", "1").output().unwrap();
+        let log = String::from_utf8_lossy(&o.stderr).into_owned();
+        assert!(o.status.success(), "{log}");
+        let bytes = std::fs::read(out.join("crossed_beams.scres")).unwrap();
+        let f = splinecontact::format::stage::StageFile::parse("r", &bytes, None).unwrap();
+        let mut dump = Vec::new();
+        f.dump_yaml(&mut dump).unwrap();
+        // the setup the results record names the option itself; nothing else may differ
+        let lines: Vec<String> = String::from_utf8(dump).unwrap().lines().filter(|l| !l.contains("residual_first")).map(str::to_string).collect();
+        (lines, log)
+    };
+    let (on, log_on) = run(true);
+    let (off, log_off) = run(false);
+    let checks = log_on
+        .lines()
+        .find_map(|l| l.split_once("assembly: ").and_then(|(_, r)| r.split_whitespace().next()).and_then(|n| n.parse::<usize>().ok()))
+        .unwrap_or_else(|| panic!("no residual-first line in the log:\n{log_on}"));
+    assert!(checks >= 3, "only {checks} iterates were checked residual first:\n{log_on}");
+    assert!(!log_off.contains("assembled residual first"), "{log_off}");
+    assert_eq!(on.len(), off.len());
+    for (a, b) in on.iter().zip(&off) {
+        assert_eq!(a, b, "the results differ");
+    }
+    eprintln!("{checks} iterates checked residual first; {} lines of results identical", on.len());
+}

@@ -134,6 +134,10 @@ pub struct FaerDirect {
     /// Entries of the pattern's lower triangle, diagonal included (set by
     /// `analyse`): the size of the permuted copy the tree factorization reads.
     lower_nnz: usize,
+    /// An analysis still running on its own thread
+    /// ([`LinearSolver::analyse_in_background`]); joined by `finish_analysis` or
+    /// the next `factor`.
+    pending: Option<std::thread::JoinHandle<Result<Analysis, LinearSolverError>>>,
     symbolic_time: Duration,
     numeric_time: Duration,
     n_symbolic: usize,
@@ -160,6 +164,7 @@ impl FaerDirect {
             widest_supernode: 0,
             tree: None,
             lower_nnz: 0,
+            pending: None,
             symbolic_time: Duration::ZERO,
             numeric_time: Duration::ZERO,
             n_symbolic: 0,
@@ -363,73 +368,48 @@ impl LinearSolver for FaerDirect {
     }
 
     fn analyse(&mut self, pattern: SymbolicSparseColMatRef<'_, usize>, symmetry: Symmetry) -> Result<(), LinearSolverError> {
-        let n = pattern.nrows();
-        if pattern.ncols() != n {
-            return Err(LinearSolverError::Dimension { what: "columns (square matrix)", expected: n, got: pattern.ncols() });
+        let owned = self.take_pattern(pattern)?;
+        let done = analysis(owned, symmetry, self.options)?;
+        self.install(done);
+        Ok(())
+    }
+
+    /// The analysis on a thread of its own while the caller goes on (the first
+    /// tangent's assembly), when rayon has more than one thread (with one, the
+    /// caller asked for one core: `analyse`).
+    fn analyse_in_background(&mut self, pattern: SymbolicSparseColMatRef<'_, usize>, symmetry: Symmetry) -> Result<(), LinearSolverError> {
+        if rayon::current_num_threads() < 2 {
+            return self.analyse(pattern, symmetry);
         }
-        let start = Instant::now();
-        self.release();
-        let owned = pattern.to_owned().map_err(|e| LinearSolverError::Faer(format!("{e:?}")))?;
-        self.diag_pos = (0..n)
-            .map(|j| {
-                let (lo, hi) = (owned.col_ptr()[j], owned.col_ptr()[j + 1]);
-                owned.row_idx()[lo..hi].binary_search(&j).map_or(usize::MAX, |k| lo + k)
-            })
-            .collect();
-        let symbolic = match symmetry {
-            Symmetry::Symmetric => {
-                let perm = match self.options.ordering {
-                    FillOrdering::Amd => None,
-                    FillOrdering::NestedDissection => Some(nested_dissection(owned.as_ref())?),
-                };
-                let ordering = match &perm {
-                    None => SymmetricOrdering::Amd,
-                    Some(p) => SymmetricOrdering::Custom(PermRef::new_checked(&p.forward, &p.inverse, n)),
-                };
-                // Supernodal always: faer's automatic choice takes the simplicial factorization
-                // when flops / nnz(L) < 40, as on the shallow ironing's one-element-thick
-                // slab (4.5k unknowns), where the supernodal one (each node's 3 dofs a dense
-                // block at least) factors in half the time (docs/performance.md).
-                let params = CholeskySymbolicParams { supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL, ..Default::default() };
-                let c = factorize_symbolic_cholesky(owned.as_ref(), Side::Lower, ordering, params)
-                    .map_err(|e| LinearSolverError::Faer(format!("{e:?}")))?;
-                crate::solver::memory::check_cholesky(c.len_val(), n, owned.compute_nnz()).map_err(LinearSolverError::TooLarge)?;
-                Symbolic::Cholesky(c)
+        let owned = self.take_pattern(pattern)?;
+        let options = self.options;
+        let (tx, rx) = std::sync::mpsc::channel();
+        let spawned = std::thread::Builder::new().name("sc-analysis".into()).spawn(move || {
+            let pattern = rx.recv().map_err(|_| LinearSolverError::Faer("the analysis thread got no pattern".into()))?;
+            analysis(pattern, symmetry, options)
+        });
+        match spawned {
+            Ok(handle) => {
+                // the pattern goes to the thread only once it runs (a failed spawn keeps it here)
+                tx.send(owned).map_err(|_| LinearSolverError::Faer("the analysis thread ended before its pattern".into()))?;
+                self.pending = Some(handle);
             }
-            Symmetry::General => Symbolic::Lu(
-                factorize_symbolic_lu(owned.as_ref(), Default::default())
-                    .map_err(|e| LinearSolverError::Faer(format!("{e:?}")))?,
-            ),
-        };
-        self.tree = match &symbolic {
-            Symbolic::Cholesky(c) if self.options.elimination_tree => match c.raw() {
-                SymbolicCholeskyRaw::Supernodal(s) => Some(TreeCholesky::new(s)),
-                SymbolicCholeskyRaw::Simplicial(_) => None,
-            },
-            _ => None,
-        };
-        self.lower_nnz = match self.tree {
-            Some(_) => {
-                let (cp, ri) = (owned.col_ptr(), owned.row_idx());
-                (0..n).map(|j| ri[cp[j]..cp[j + 1]].iter().filter(|&&i| i >= j).count()).sum()
-            }
-            None => 0,
-        };
-        self.pattern = Some(owned);
-        self.widest_supernode = match &symbolic {
-            Symbolic::Cholesky(c) => match c.raw() {
-                SymbolicCholeskyRaw::Supernodal(s) => s.supernode_begin().iter().zip(s.supernode_end()).map(|(b, e)| e - b).max().unwrap_or(0),
-                SymbolicCholeskyRaw::Simplicial(_) => 1,
-            },
-            Symbolic::Lu(_) => 0,
-        };
-        self.symbolic = Some(symbolic);
-        self.symbolic_time += start.elapsed();
-        self.n_symbolic += 1;
+            // no thread to be had: the analysis here
+            Err(_) => self.install(analysis(owned, symmetry, options)?),
+        }
+        Ok(())
+    }
+
+    fn finish_analysis(&mut self) -> Result<(), LinearSolverError> {
+        if let Some(handle) = self.pending.take() {
+            let done = handle.join().map_err(|_| LinearSolverError::Faer("the analysis thread panicked".into()))??;
+            self.install(done);
+        }
         Ok(())
     }
 
     fn factor(&mut self, values: &[f64]) -> Result<FactorInfo, LinearSolverError> {
+        self.finish_analysis()?;
         let pattern = check_values(self.pattern.as_ref(), values)?;
         let start = Instant::now();
         self.numeric = Numeric::None;
@@ -486,6 +466,13 @@ impl FaerDirect {
     /// Drops the pattern, the analysis and the factor (their memory), as a new
     /// `analyse` would before building its own.
     pub fn release(&mut self) {
+        if let Some(handle) = self.pending.take() {
+            // its result is of the pattern being replaced: dropped, its time counted
+            if let Ok(Ok(a)) = handle.join() {
+                self.symbolic_time += a.time;
+                self.n_symbolic += 1;
+            }
+        }
         self.numeric = Numeric::None;
         self.symbolic = None;
         self.pattern = None;
@@ -538,6 +525,97 @@ impl FaerDirect {
         Ok(())
     }
 
+}
+
+/// What `analyse` makes of a pattern: everything a numeric factorization reads.
+struct Analysis {
+    pattern: SymbolicSparseColMat<usize>,
+    diag_pos: Vec<usize>,
+    symbolic: Symbolic,
+    tree: Option<TreeCholesky>,
+    lower_nnz: usize,
+    widest_supernode: usize,
+    time: Duration,
+}
+
+impl FaerDirect {
+    /// The checked, owned copy of a pattern to analyse; the old pattern, analysis
+    /// and factor are dropped first (peak memory).
+    fn take_pattern(&mut self, pattern: SymbolicSparseColMatRef<'_, usize>) -> Result<SymbolicSparseColMat<usize>, LinearSolverError> {
+        let n = pattern.nrows();
+        if pattern.ncols() != n {
+            return Err(LinearSolverError::Dimension { what: "columns (square matrix)", expected: n, got: pattern.ncols() });
+        }
+        self.release();
+        pattern.to_owned().map_err(|e| LinearSolverError::Faer(format!("{e:?}")))
+    }
+
+    fn install(&mut self, a: Analysis) {
+        self.pattern = Some(a.pattern);
+        self.diag_pos = a.diag_pos;
+        self.symbolic = Some(a.symbolic);
+        self.tree = a.tree;
+        self.lower_nnz = a.lower_nnz;
+        self.widest_supernode = a.widest_supernode;
+        self.symbolic_time += a.time;
+        self.n_symbolic += 1;
+    }
+}
+
+/// Ordering and symbolic factorization of `owned` (on any thread: it reads nothing
+/// but its arguments).
+fn analysis(owned: SymbolicSparseColMat<usize>, symmetry: Symmetry, options: FaerDirectOptions) -> Result<Analysis, LinearSolverError> {
+    let start = Instant::now();
+    let n = owned.nrows();
+    let diag_pos = (0..n)
+        .map(|j| {
+            let (lo, hi) = (owned.col_ptr()[j], owned.col_ptr()[j + 1]);
+            owned.row_idx()[lo..hi].binary_search(&j).map_or(usize::MAX, |k| lo + k)
+        })
+        .collect();
+    let symbolic = match symmetry {
+        Symmetry::Symmetric => {
+            let perm = match options.ordering {
+                FillOrdering::Amd => None,
+                FillOrdering::NestedDissection => Some(nested_dissection(owned.as_ref())?),
+            };
+            let ordering = match &perm {
+                None => SymmetricOrdering::Amd,
+                Some(p) => SymmetricOrdering::Custom(PermRef::new_checked(&p.forward, &p.inverse, n)),
+            };
+            // Supernodal always: faer's automatic choice takes the simplicial factorization
+            // when flops / nnz(L) < 40, as on the shallow ironing's one-element-thick
+            // slab (4.5k unknowns), where the supernodal one (each node's 3 dofs a dense
+            // block at least) factors in half the time (docs/performance.md).
+            let params = CholeskySymbolicParams { supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL, ..Default::default() };
+            let c = factorize_symbolic_cholesky(owned.as_ref(), Side::Lower, ordering, params).map_err(|e| LinearSolverError::Faer(format!("{e:?}")))?;
+            crate::solver::memory::check_cholesky(c.len_val(), n, owned.compute_nnz()).map_err(LinearSolverError::TooLarge)?;
+            Symbolic::Cholesky(c)
+        }
+        Symmetry::General => Symbolic::Lu(factorize_symbolic_lu(owned.as_ref(), Default::default()).map_err(|e| LinearSolverError::Faer(format!("{e:?}")))?),
+    };
+    let tree = match &symbolic {
+        Symbolic::Cholesky(c) if options.elimination_tree => match c.raw() {
+            SymbolicCholeskyRaw::Supernodal(s) => Some(TreeCholesky::new(s)),
+            SymbolicCholeskyRaw::Simplicial(_) => None,
+        },
+        _ => None,
+    };
+    let lower_nnz = match tree {
+        Some(_) => {
+            let (cp, ri) = (owned.col_ptr(), owned.row_idx());
+            (0..n).map(|j| ri[cp[j]..cp[j + 1]].iter().filter(|&&i| i >= j).count()).sum()
+        }
+        None => 0,
+    };
+    let widest_supernode = match &symbolic {
+        Symbolic::Cholesky(c) => match c.raw() {
+            SymbolicCholeskyRaw::Supernodal(s) => s.supernode_begin().iter().zip(s.supernode_end()).map(|(b, e)| e - b).max().unwrap_or(0),
+            SymbolicCholeskyRaw::Simplicial(_) => 1,
+        },
+        Symbolic::Lu(_) => 0,
+    };
+    Ok(Analysis { pattern: owned, diag_pos, symbolic, tree, lower_nnz, widest_supernode, time: start.elapsed() })
 }
 
 #[cfg(test)]

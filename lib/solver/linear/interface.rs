@@ -74,6 +74,18 @@ pub trait LinearSolver: Send {
     /// ordering and symbolic factorization. Call again when the pattern or the
     /// symmetry changes; invalidates the previous factorization.
     fn analyse(&mut self, pattern: SymbolicSparseColMatRef<'_, usize>, symmetry: Symmetry) -> Result<(), LinearSolverError>;
+    /// `analyse`, possibly still running when it returns (on a thread of its own,
+    /// while the caller assembles the first tangent); its errors then come from
+    /// [`Self::finish_analysis`], which `factor` calls first. A backend without
+    /// a background analysis does it here.
+    fn analyse_in_background(&mut self, pattern: SymbolicSparseColMatRef<'_, usize>, symmetry: Symmetry) -> Result<(), LinearSolverError> {
+        self.analyse(pattern, symmetry)
+    }
+    /// Waits for an analysis started by [`Self::analyse_in_background`]; its error,
+    /// if it failed.
+    fn finish_analysis(&mut self) -> Result<(), LinearSolverError> {
+        Ok(())
+    }
     /// Numeric factorization of the matrix with these values (pattern order).
     fn factor(&mut self, values: &[f64]) -> Result<FactorInfo, LinearSolverError>;
     /// Overwrites `rhs` with the solution of `A x = rhs`.

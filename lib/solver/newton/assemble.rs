@@ -16,7 +16,7 @@ use super::Newton;
 use crate::assembly::{Assembly, ElementFailure, DOFS_PER_NODE};
 use crate::contact::law::ContactElementError;
 use crate::contact::pair::PairSolver;
-use crate::fem::element::{hex8_residual_tangent, ElementError};
+use crate::fem::element::{hex8_residual, hex8_residual_tangent, ElementError};
 use crate::fem::pressure::{follower_pressure_force_stiffness, FaceMatrix, FaceVector};
 use crate::solver::ranks;
 
@@ -98,8 +98,9 @@ impl Newton<'_> {
     }
 
     /// Assemble K_ff and the full residual R = f_int − f_ext(λ) at `u` (after
-    /// [`Self::contact_search`] at the same `u`).
-    pub(super) fn assemble(&mut self, u: &[f64], lambda: f64) -> Result<(), AssemblyFailure> {
+    /// [`Self::contact_search`] at the same `u`); with `tangent` false, R alone (the
+    /// same bits; K_ff is then not that of `u`).
+    pub(super) fn assemble(&mut self, u: &[f64], lambda: f64, tangent: bool) -> Result<(), AssemblyFailure> {
         let p = self.problem;
         let hex_ids = self.partition.as_ref().map(|part| &part.hex_ids[..]);
         let hex = |e: usize, r: &mut _, k: &mut _| {
@@ -129,9 +130,18 @@ impl Newton<'_> {
             }
             Ok(())
         };
-        let res = self.assembly.assemble_with_groups(&self.pattern, hex, group);
+        let res = if tangent {
+            self.assembly.assemble_with_groups(&self.pattern, hex, group).map(|(_, r)| r)
+        } else {
+            let hex_residual = |e: usize, r: &mut _| {
+                let e = hex_ids.map_or(e, |ids| ids[e] as usize);
+                let (X, ue) = p.gather(e, u);
+                hex8_residual(&X, &ue, &p.materials[p.hex_material[e] as usize], p.formulation, r).map_err(LocalFailure::Hex)
+            };
+            self.assembly.assemble_residual_with_groups(&self.pattern, hex_residual, group)
+        };
         let (full, failure) = match res {
-            Ok((_, r)) => (Some(r), None),
+            Ok(r) => (Some(r), None),
             Err(ElementFailure::Hex { element, error }) | Err(ElementFailure::Group { group: element, error }) => {
                 let f = match error {
                     LocalFailure::Hex(error) => AssemblyFailure::Hex(hex_ids.map_or(element, |ids| ids[element] as usize), error),
@@ -166,11 +176,15 @@ impl Newton<'_> {
         }
         if let Some(s) = &self.stabilization {
             s.add_residual(u, &mut self.residual);
-            s.add_tangent(&self.pattern, self.assembly.values_mut());
+            if tangent {
+                s.add_tangent(&self.pattern, self.assembly.values_mut());
+            }
         }
         if let Some(f) = &self.free_bodies {
             f.add_residual(u, &mut self.residual);
-            f.add_tangent(&self.pattern, self.assembly.values_mut());
+            if tangent {
+                f.add_tangent(&self.pattern, self.assembly.values_mut());
+            }
         }
         Ok(())
     }

@@ -23,6 +23,10 @@ pub enum IncrementFailure {
     Diverged { iteration: u32, residual: f64 },
     #[error("iteration {iteration}: linear solver: {error}")]
     Linear { iteration: u32, error: LinearSolverError },
+    /// The linear solver's first analysis, run in the background while the first
+    /// tangent was assembled, failed: an error of the setup, which no cutback mends.
+    #[error("linear solver: {error}")]
+    Setup { error: LinearSolverError },
     #[error("iteration {iteration}: contact pair '{pair}', slave node {node_tag}: {error}")]
     Contact { iteration: u32, pair: String, node_tag: u64, error: ContactElementError },
     #[error("iteration {iteration}: {message}")]

@@ -46,6 +46,17 @@ const MORTAR_HOLD_RESIDUAL: f64 = 1e-5;
 /// test's pressure 5e-6 off when held from 1e-2), in that increment only.
 pub(super) const MORTAR_EARLY_HOLD_RESIDUAL: f64 = 1e-1;
 
+/// An iterate is assembled residual first (no tangent; the tangent follows only if
+/// it has not converged) when Newton's quadratic rate predicts convergence,
+/// r_{i-1}² / r_{i-2} ≤ this × the residual tolerance. The converged iterate of an
+/// increment needs no tangent; the residual alone costs about a quarter of the
+/// residual and tangent (hex8: 1.2 µs against 4.7 µs, and no scatter into K_ff),
+/// so a wrong guess costs a quarter of an assembly and a right one saves three
+/// quarters. The margin takes the rates before the asymptotic regime, often faster
+/// than quadratic from a large first residual (Parisch r = 6: r_0 = 1,
+/// r_1 = 1.6e-4, predicted 2.5e-8, converged at 2.4e-10).
+pub(super) const RESIDUAL_FIRST_MARGIN: f64 = 100.0;
+
 impl Newton<'_> {
     /// Solve the increment at load factor `lambda`, starting from `u` (the previous
     /// converged state), which is updated in place. `on_iteration` sees each row.
@@ -76,11 +87,16 @@ impl Newton<'_> {
         }
         let dofs = &p.dofs;
         let mut last_r_norm = f64::INFINITY;
+        // relative residuals of the last two iterates: r_{i-2}, r_{i-1}
+        let mut last_residuals = [f64::INFINITY; 2];
         for iteration in 0..=self.settings.max_iterations {
             if self.settings.search_updates > 0 && iteration == self.settings.search_updates {
                 self.freeze_contact(iteration, "search_updates reached");
             }
-            let Assembled { r_norm, seconds_contact, seconds_assembly } = self.assemble_iterate(u, lambda, iteration, last_r_norm)?;
+            let [r_2, r_1] = last_residuals;
+            let residual_first = self.settings.residual_first && iteration >= 2 && r_1 * r_1 <= RESIDUAL_FIRST_MARGIN * self.settings.residual_tolerance * r_2;
+            self.residual_first.0 += usize::from(residual_first);
+            let Assembled { r_norm, seconds_contact, seconds_assembly } = self.assemble_iterate(u, lambda, iteration, last_r_norm, !residual_first)?;
             last_r_norm = r_norm;
             let reaction_norm = self.reaction_norm();
             // Reference force: the external load, or the largest reaction seen in this
@@ -92,6 +108,7 @@ impl Newton<'_> {
             if !residual.is_finite() && r_norm != 0.0 && reference > 0.0 {
                 return Err(IncrementFailure::Diverged { iteration, residual });
             }
+            last_residuals = [r_1, residual];
             if iteration == 0 {
                 first_residual = residual;
             } else {
@@ -151,6 +168,22 @@ impl Newton<'_> {
             if let Err(failure) = self.check_cycles(&mut cycles, iteration, residual) {
                 on_iteration(&row);
                 return Err(failure);
+            }
+            if residual_first {
+                // not converged after all: the tangent at the same state (no new
+                // search; the residual is the same, bit for bit)
+                self.residual_first.1 += 1;
+                let t = Instant::now();
+                if let Err(f) = self.assemble(u, lambda, true) {
+                    self.release_contact();
+                    return Err(f.into_increment_failure(iteration, &self.contact, &p.node_tags));
+                }
+                dofs.gather_free(&self.residual, &mut self.rhs);
+                row.seconds_assembly += clock::seconds_since(t);
+            }
+            if std::mem::take(&mut self.analysis_pending) {
+                // its failure (a factor too large for the memory) is the setup's
+                self.linear.finish_analysis().map_err(|error| IncrementFailure::Setup { error })?;
             }
             let t = Instant::now();
             self.linear.set_configuration(&self.problem.X, u);

@@ -104,6 +104,12 @@ pub struct Newton<'p> {
     group_scratch: NodeGroups,
     /// Times the pattern was rebuilt because contact groups changed.
     pub pattern_rebuilds: u32,
+    /// Iterates assembled residual first (`NewtonSetup::residual_first`), and how
+    /// many of them had not converged and took the tangent after.
+    pub residual_first: (usize, usize),
+    /// The linear solver's first analysis may still be running (`Newton::new`
+    /// started it in the background).
+    analysis_pending: bool,
     /// The symmetry the linear solver was set up for.
     symmetry: Symmetry,
     /// Newton corrections halved because they inverted an element (all solves).
@@ -217,7 +223,9 @@ impl<'p> Newton<'p> {
                 _ => Box::new(FaerDirect::new(direct)),
             }
         };
-        linear.analyse(pattern.symbolic(), symmetry)?;
+        // the first analysis runs while the first tangent is assembled; the first
+        // factorization waits for it (`solve_increment`)
+        linear.analyse_in_background(pattern.symbolic(), symmetry)?;
         let n = DOFS_PER_NODE * problem.n_nodes();
         let n_free = pattern.n_free();
         let stabilization = Stabilization::new(problem, &contact);
@@ -241,6 +249,8 @@ impl<'p> Newton<'p> {
             partition,
             group_scratch: NodeGroups::new(),
             pattern_rebuilds: 0,
+            residual_first: (0, 0),
+            analysis_pending: true,
             symmetry,
             step_halvings: 0,
             line_search_steps: 0,
@@ -263,7 +273,7 @@ impl<'p> Newton<'p> {
     pub fn residual_tangent_at(&mut self, u: &[f64], lambda: f64) -> Result<ResidualTangent, IncrementFailure> {
         self.contact_search(u, 0)?;
         let node_tags = &self.problem.node_tags;
-        self.assemble(u, lambda).map_err(|f| f.into_increment_failure(0, &self.contact, node_tags))?;
+        self.assemble(u, lambda, true).map_err(|f| f.into_increment_failure(0, &self.contact, node_tags))?;
         Ok((self.residual.clone(), self.pattern.col_ptr().to_vec(), self.pattern.row_idx().to_vec(), self.assembly.values().to_vec()))
     }
 

@@ -33,8 +33,8 @@ impl Newton<'_> {
     /// Contact search and assembly at `u` for `iteration` of the solve at `lambda`,
     /// halving the last correction (kept in `r_free`, `u` moves back with it) while
     /// the iterate inverts an element or, under the line search, its ‖R_f‖ is above
-    /// `last_r_norm`. Leaves R_f in `rhs`.
-    pub(super) fn assemble_iterate(&mut self, u: &mut [f64], lambda: f64, iteration: u32, last_r_norm: f64) -> Result<Assembled, IncrementFailure> {
+    /// `last_r_norm`. Leaves R_f in `rhs`, and K_ff in the assembly when `tangent`.
+    pub(super) fn assemble_iterate(&mut self, u: &mut [f64], lambda: f64, iteration: u32, last_r_norm: f64, tangent: bool) -> Result<Assembled, IncrementFailure> {
         let p = self.problem;
         let dofs = &p.dofs;
         // From the second correction on, a correction that raises ‖R_f‖ is
@@ -49,7 +49,7 @@ impl Newton<'_> {
             self.contact_search(u, iteration)?;
             seconds_contact += clock::seconds_since(t);
             let t = Instant::now();
-            let assembled = self.assemble(u, lambda);
+            let assembled = self.assemble(u, lambda, tangent);
             seconds_assembly += clock::seconds_since(t);
             match assembled {
                 Ok(()) => {

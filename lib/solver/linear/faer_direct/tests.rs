@@ -289,3 +289,54 @@ fn the_elimination_tree_factor_is_faers_own_bit_for_bit_with_sequential_kernels(
     let bits = |l: Vec<f64>| l.into_iter().map(f64::to_bits).collect::<Vec<_>>();
     assert_eq!(bits(factor(true)), bits(factor(false)));
 }
+
+/// `analyse_in_background` leaves what `analyse` leaves: on 2 rayon threads the
+/// analysis runs on a thread of its own (pending until `factor` joins it), on one
+/// in place, and the factor is the same, bit for bit, with the analysis counted
+/// once. A pattern analysed anew while the background analysis still runs waits for
+/// it and drops it. (Its failure, a factor too large for the memory, reaches the
+/// user as the setup error it was before: `cli::solve`,
+/// `a_model_too_large_for_memory_fails_before_factorization_with_an_estimate`.)
+#[test]
+fn the_background_analysis_is_the_analysis() {
+    let cube = elastic_cube_system(8).unwrap();
+    let p = cube.pattern.symbolic_owned();
+    let factor = |background: bool, threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| {
+            let mut s = FaerDirect::new(FaerDirectOptions { par: Some(Par::Seq), ..Default::default() });
+            if background {
+                s.analyse_in_background(p.as_ref(), Symmetry::Symmetric).unwrap();
+                assert_eq!(s.pending.is_some(), threads > 1, "{threads} threads");
+            } else {
+                s.analyse(p.as_ref(), Symmetry::Symmetric).unwrap();
+            }
+            assert_eq!(s.factor(cube.assembly.values()).unwrap().method, Factorization::Llt);
+            assert!(s.pending.is_none() && s.timings().n_symbolic == 1);
+            let mut x = cube.rhs.clone();
+            s.solve_in_place(&mut x).unwrap();
+            assert!(residual_of(p, cube.assembly.values(), &x, &cube.rhs) < 1e-12);
+            s.l_values.into_iter().map(f64::to_bits).collect::<Vec<_>>()
+        })
+    };
+    let direct = factor(false, 2);
+    assert_eq!(factor(true, 2), direct);
+    assert_eq!(factor(true, 1), direct);
+
+    // replaced while running: the new pattern's analysis is the one kept
+    let small = elastic_cube_system(3).unwrap();
+    let q = small.pattern.symbolic_owned();
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+    pool.install(|| {
+        let mut s = FaerDirect::default();
+        s.analyse_in_background(p.as_ref(), Symmetry::Symmetric).unwrap();
+        s.analyse(q.as_ref(), Symmetry::Symmetric).unwrap();
+        assert!(s.pending.is_none());
+        assert_eq!(s.pattern().unwrap().nrows(), q.nrows());
+        s.factor(small.assembly.values()).unwrap();
+        assert_eq!(s.timings().n_symbolic, 2, "both analyses ran, and both are counted");
+        let mut x = small.rhs.clone();
+        s.solve_in_place(&mut x).unwrap();
+        assert!(residual_of(q, small.assembly.values(), &x, &small.rhs) < 1e-12);
+    });
+}
