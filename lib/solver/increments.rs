@@ -227,6 +227,7 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
     let mut trial = u.clone();
     let mut summary = SolveSummary { increments: 0, iterations: 0, cutbacks: 0, write_seconds: 0.0 };
     let mut file = if out.writer { ResultsFile::new(out.results) } else { ResultsFile::not_written(out.results) };
+    let mut csvs = WrittenCsvs::default();
     let n_inc = factors.len();
     for (k, &target) in factors.iter().enumerate().skip(first) {
         let mut lambda = target;
@@ -331,7 +332,7 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
                         face_pressure,
                         charts,
                     });
-                    write(&mut file, results, out, log)?;
+                    write(&mut file, &mut csvs, results, out, log)?;
                     if !out.writer {
                         // nor does it keep the history's arrays (0.2 GB an increment at
                         // 1M dofs); the count and the summaries stay
@@ -381,25 +382,38 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
         log.increment_done();
     }
     results.status = RunStatus::Completed;
-    write(&mut file, results, out, log)?;
+    write(&mut file, &mut csvs, results, out, log)?;
     log.line(&format!("results: {} increments, {:.1} MB written to {} in {:.2} s", results.increments.len(), file.bytes as f64 / 1e6, out.results.display(), file.seconds));
     summary.write_seconds = file.seconds;
     Ok(summary)
 }
 
+/// The two CSV histories as last written (each rewrite is a temporary file, an
+/// fdatasync and a rename: one whose text has not changed is skipped).
+#[derive(Default)]
+struct WrittenCsvs {
+    convergence: Option<String>,
+    forces: Option<String>,
+}
+
 /// Bring the results file up to date (append what converged since) and rewrite the
-/// two CSV histories.
-fn write(file: &mut ResultsFile, results: &Results, out: &Outputs, log: &SolveLog) -> Result<(), StageError> {
+/// two CSV histories where they changed.
+fn write(file: &mut ResultsFile, written: &mut WrittenCsvs, results: &Results, out: &Outputs, log: &SolveLog) -> Result<(), StageError> {
     file.sync(results)?;
     if !out.writer {
         return Ok(());
     }
-    if let Some(csv) = out.csv {
-        write_atomic(csv, log.csv().as_bytes())?;
-    }
-    if let Some(f) = out.forces_csv {
-        write_atomic(f, forces_csv(results).as_bytes())?;
-    }
+    let rewrite = |path: Option<&Path>, text: &str, last: &mut Option<String>| -> Result<(), StageError> {
+        if let Some(path) = path {
+            if last.as_deref() != Some(text) {
+                write_atomic(path, text.as_bytes())?;
+                *last = Some(text.to_owned());
+            }
+        }
+        Ok(())
+    };
+    rewrite(out.csv, log.csv(), &mut written.convergence)?;
+    rewrite(out.forces_csv, &forces_csv(results), &mut written.forces)?;
     Ok(())
 }
 
