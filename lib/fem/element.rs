@@ -266,10 +266,9 @@ impl SpatialStiffness {
                 for a in 0..8 {
                     s[a] = gc[0][a] * t[0] + gc[1][a] * t[1] + gc[2][a] * t[2];
                 }
-                for j in 0..3 {
-                    let col = &mut ktb[j][j];
-                    for a in 0..8 {
-                        col[a] += s[a];
+                for (j, ktbj) in ktb.iter_mut().enumerate() {
+                    for (v, sa) in ktbj[j].iter_mut().zip(&s) {
+                        *v += sa;
                     }
                 }
             }
