@@ -310,20 +310,7 @@ impl Assembly {
         if let Some((element, error)) = hex_failure {
             return Err(ElementFailure::Hex { element, error });
         }
-        let group_failure = self
-            .k_grp
-            .par_iter_mut()
-            .zip(self.r_grp.par_iter_mut())
-            .enumerate()
-            .filter_map(|(g, (k, r))| {
-                k.fill(0.0);
-                r.fill(0.0);
-                group(g, r, k).err().map(|error| (g, error))
-            })
-            .min_by_key(|(g, _)| *g);
-        if let Some((group, error)) = group_failure {
-            return Err(ElementFailure::Group { group, error });
-        }
+        self.compute_groups(group)?;
         self.timings.compute = start.elapsed();
 
         // Phase 2: the groups' matrices in group order, and the residual's
@@ -367,6 +354,21 @@ impl Assembly {
         if let Some((element, error)) = hex_failure {
             return Err(ElementFailure::Hex { element, error });
         }
+        self.compute_groups(group)?;
+        self.timings.compute = start.elapsed();
+        let start = std::time::Instant::now();
+        self.gather_residual();
+        self.timings.sum = start.elapsed();
+        Ok(&self.residual)
+    }
+
+    /// Every contact group's residual and tangent into its own buffers, in parallel;
+    /// the failure of the lowest group index, if any.
+    fn compute_groups<E, G>(&mut self, group: G) -> Result<(), ElementFailure<E>>
+    where
+        E: Send,
+        G: Fn(usize, &mut DVector<f64>, &mut DMatrix<f64>) -> Result<(), E> + Sync,
+    {
         let group_failure = self
             .k_grp
             .par_iter_mut()
@@ -378,14 +380,10 @@ impl Assembly {
                 group(g, r, k).err().map(|error| (g, error))
             })
             .min_by_key(|(g, _)| *g);
-        if let Some((group, error)) = group_failure {
-            return Err(ElementFailure::Group { group, error });
+        match group_failure {
+            Some((group, error)) => Err(ElementFailure::Group { group, error }),
+            None => Ok(()),
         }
-        self.timings.compute = start.elapsed();
-        let start = std::time::Instant::now();
-        self.gather_residual();
-        self.timings.sum = start.elapsed();
-        Ok(&self.residual)
     }
 
     /// Every dof's residual: its contributions from the hexahedra's and the groups'

@@ -37,6 +37,8 @@ pub fn solve_augmented(newton: &mut Newton, lambda: f64, u: &mut [f64], on_itera
         }
         let conv = match solved {
             Ok(conv) => conv,
+            // the setup's failure: no update mends it
+            Err(failure @ IncrementFailure::Setup { .. }) => return Err(failure),
             Err(failure) if theta > 0.5f64.powi(halvings_allowed(newton, &update)) => {
                 theta *= 0.5;
                 note(&format!("Newton failed after the Uzawa update ({failure}): solving again with {theta} of the update"));
