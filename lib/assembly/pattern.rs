@@ -199,10 +199,11 @@ impl Pattern {
             rest = tail;
         }
         node_rows.into_par_iter().enumerate().for_each(|(a, out)| {
-            let n_rows = rows_of_node[a];
             if out.is_empty() {
                 return; // no free dof: no column
             }
+            // out holds the node's free columns of n_rows each: non-empty, n_rows ≥ 1
+            let n_rows = rows_of_node[a];
             let mut k = 0;
             for &b in &neighbours[a] {
                 for c in 0..DOFS_PER_NODE {
@@ -213,8 +214,8 @@ impl Pattern {
                 }
             }
             // the node's other free columns repeat its first
-            let (first, others) = out.split_at_mut(n_rows.min(out.len()));
-            for column in others.chunks_exact_mut(n_rows.max(1)) {
+            let (first, others) = out.split_at_mut(n_rows);
+            for column in others.chunks_exact_mut(n_rows) {
                 column.copy_from_slice(first);
             }
         });

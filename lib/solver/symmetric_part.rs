@@ -352,19 +352,16 @@ impl SymmetricPartGmres {
         if self.general_pattern(pattern.row_idx().len()) {
             self.lu.analyse(pattern, Symmetry::General)?;
             self.lu_analysed = true;
+        } else if background {
+            self.symmetric.analyse_in_background(pattern, Symmetry::Symmetric)?;
         } else {
-            if background {
-                self.symmetric.analyse_in_background(pattern, Symmetry::Symmetric)?;
-            } else {
-                self.symmetric.analyse(pattern, Symmetry::Symmetric)?;
-            }
+            self.symmetric.analyse(pattern, Symmetry::Symmetric)?;
         }
         self.analysed = true;
         self.symbolic_time += start.elapsed();
         self.n_symbolic += 1;
         Ok(())
     }
-
 }
 
 impl LinearSolver for SymmetricPartGmres {

@@ -103,10 +103,15 @@ impl Newton<'_> {
     pub(super) fn assemble(&mut self, u: &[f64], lambda: f64, tangent: bool) -> Result<(), AssemblyFailure> {
         let p = self.problem;
         let hex_ids = self.partition.as_ref().map(|part| &part.hex_ids[..]);
-        let hex = |e: usize, r: &mut _, k: &mut _| {
+        // hexahedron e of this rank's share: its reference nodes, displacements and material
+        let local = |e: usize| {
             let e = hex_ids.map_or(e, |ids| ids[e] as usize);
             let (X, ue) = p.gather(e, u);
-            hex8_residual_tangent(&X, &ue, &p.materials[p.hex_material[e] as usize], p.formulation, r, k).map_err(LocalFailure::Hex)
+            (X, ue, &p.materials[p.hex_material[e] as usize])
+        };
+        let hex = |e: usize, r: &mut _, k: &mut _| {
+            let (X, ue, mat) = local(e);
+            hex8_residual_tangent(&X, &ue, mat, p.formulation, r, k).map_err(LocalFailure::Hex)
         };
         let (owners, contact) = (&self.owners, &self.contact);
         // Follower pressure: an external force, so the residual gets −f and the tangent −∂f/∂x.
@@ -134,9 +139,8 @@ impl Newton<'_> {
             self.assembly.assemble_with_groups(&self.pattern, hex, group).map(|(_, r)| r)
         } else {
             let hex_residual = |e: usize, r: &mut _| {
-                let e = hex_ids.map_or(e, |ids| ids[e] as usize);
-                let (X, ue) = p.gather(e, u);
-                hex8_residual(&X, &ue, &p.materials[p.hex_material[e] as usize], p.formulation, r).map_err(LocalFailure::Hex)
+                let (X, ue, mat) = local(e);
+                hex8_residual(&X, &ue, mat, p.formulation, r).map_err(LocalFailure::Hex)
             };
             self.assembly.assemble_residual_with_groups(&self.pattern, hex_residual, group)
         };

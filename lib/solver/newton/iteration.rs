@@ -181,10 +181,10 @@ impl Newton<'_> {
                 dofs.gather_free(&self.residual, &mut self.rhs);
                 row.seconds_assembly += clock::seconds_since(t);
             }
-            if std::mem::take(&mut self.analysis_pending) {
-                // its failure (a factor too large for the memory) is the setup's
-                self.linear.finish_analysis().map_err(|error| IncrementFailure::Setup { error })?;
-            }
+            // the first analysis, if it still runs (`Newton::new` started it in the
+            // background; nothing to wait for after it): its failure (a factor too
+            // large for the memory) is the setup's
+            self.linear.finish_analysis().map_err(|error| IncrementFailure::Setup { error })?;
             let t = Instant::now();
             self.linear.set_configuration(&self.problem.X, u);
             self.linear.factor(self.assembly.values()).map_err(|error| IncrementFailure::Linear { iteration, error })?;

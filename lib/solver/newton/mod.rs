@@ -107,9 +107,6 @@ pub struct Newton<'p> {
     /// Iterates assembled residual first (`NewtonSetup::residual_first`), and how
     /// many of them had not converged and took the tangent after.
     pub residual_first: (usize, usize),
-    /// The linear solver's first analysis may still be running (`Newton::new`
-    /// started it in the background).
-    analysis_pending: bool,
     /// The symmetry the linear solver was set up for.
     symmetry: Symmetry,
     /// Newton corrections halved because they inverted an element (all solves).
@@ -250,7 +247,6 @@ impl<'p> Newton<'p> {
             group_scratch: NodeGroups::new(),
             pattern_rebuilds: 0,
             residual_first: (0, 0),
-            analysis_pending: true,
             symmetry,
             step_halvings: 0,
             line_search_steps: 0,
