@@ -338,11 +338,27 @@ pub enum OrderingChoice {
     Amd,
 }
 
+/// Precision of the Cholesky factor of `direct` and `gmres` (`auto`), which GMRES
+/// makes exact.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum PrecisionChoice {
+    /// `f32` values: half the factor's memory and traffic; every solve by GMRES to
+    /// `gmres_tolerance`, and a factor that `f32` cannot hold is made in `f64`.
+    #[default]
+    Single,
+    /// `f64` values: a fresh factor of a symmetric tangent solves directly.
+    Double,
+}
+
 /// The linear solver: `linear_solver: auto` (a method alone) or a map with these keys.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct LinearSolverSetup {
     pub method: LinearSolverChoice,
     pub ordering: OrderingChoice,
+    /// Precision of the Cholesky factor of `direct` / `gmres` (`cholesky` and `ldlt`
+    /// always factor in double).
+    pub factor_precision: PrecisionChoice,
     /// GMRES: relative residual ‖b − K x‖/‖b‖ to reach.
     pub gmres_tolerance: f64,
     /// GMRES: most iterations per solve before the LU fallback.
@@ -364,6 +380,7 @@ impl Default for LinearSolverSetup {
         Self {
             method: LinearSolverChoice::Auto,
             ordering: OrderingChoice::NestedDissection,
+            factor_precision: PrecisionChoice::default(),
             gmres_tolerance: 1e-12,
             gmres_max_iterations: 100,
             preconditioner_reuse: 8,
@@ -387,6 +404,8 @@ struct LinearSolverMap {
     method: LinearSolverChoice,
     #[serde(default)]
     ordering: OrderingChoice,
+    #[serde(default)]
+    factor_precision: PrecisionChoice,
     gmres_tolerance: Option<f64>,
     gmres_max_iterations: Option<u32>,
     preconditioner_reuse: Option<u32>,
@@ -401,7 +420,7 @@ impl<'de> Deserialize<'de> for LinearSolverSetup {
         impl<'de> serde::de::Visitor<'de> for Visitor {
             type Value = LinearSolverSetup;
             fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-                f.write_str("a method (auto, direct, cholesky, ldlt, lu, gmres, petsc) or a map with keys method, ordering, gmres_tolerance, gmres_max_iterations, preconditioner_reuse, inexact_newton, petsc")
+                f.write_str("a method (auto, direct, cholesky, ldlt, lu, gmres, petsc) or a map with keys method, ordering, factor_precision, gmres_tolerance, gmres_max_iterations, preconditioner_reuse, inexact_newton, petsc")
             }
             fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<Self::Value, E> {
                 let method = LinearSolverChoice::deserialize(serde::de::value::StrDeserializer::<E>::new(v))?;
@@ -427,6 +446,7 @@ impl<'de> Deserialize<'de> for LinearSolverSetup {
                 Ok(LinearSolverSetup {
                     method: m.method,
                     ordering: m.ordering,
+                    factor_precision: m.factor_precision,
                     gmres_tolerance: tolerance,
                     gmres_max_iterations: m.gmres_max_iterations.unwrap_or(d.gmres_max_iterations),
                     preconditioner_reuse: m.preconditioner_reuse.unwrap_or(d.preconditioner_reuse),

@@ -23,9 +23,8 @@
 //! preconditioner again.
 //!
 //! The result is the solution of `K x = b` to the relative residual
-//! [`GmresSettings::tolerance`] (1e-12 by default, far below Newton's 1e-8), so
-//! Newton's iterates, and its iteration counts, are those of the direct solve up
-//! to round-off.
+//! [`GmresSettings::tolerance`] (1e-12 by default, far below Newton's 1e-8, or
+//! the inexact Newton's forcing term, [`LinearSolver::set_forcing`]).
 //!
 //! **Keeping the factorization.** A factorization of `S` is kept for the next Newton
 //! iteration while the last solve needed at most `reuse_below` GMRES iterations
@@ -43,6 +42,18 @@
 //! peak memory of a factorization is the direct solver's); a factorization that
 //! fails is an error (a singular tangent is reported with its dof, as by
 //! [`FaerDirect`]; no LU).
+//!
+//! **Single precision** ([`super::linear::FactorPrecision::Single`], the default
+//! of `linear_solver: direct`). The factor of `S` (of `K` itself when it is
+//! symmetric) is made in `f32`: half the bytes, so half the memory traffic of
+//! the factorization and of every triangular solve, and twice the SIMD lanes.
+//! Its solves are then accurate to about κ · 6e-8, so every solve, a fresh
+//! factor's included, is a GMRES solve with it as preconditioner, to the same
+//! tolerance, and Newton takes the inexact forcing terms of the frictional path.
+//! When GMRES does not converge with a fresh single-precision factor, `S` is
+//! factored in `f64` and the solve repeated (before the LU fallback); a factor
+//! that `f32` cannot hold (a non-positive or tiny pivot) is made in `f64` at once
+//! ([`FaerDirect`]).
 
 use std::time::{Duration, Instant};
 
@@ -55,6 +66,12 @@ use super::linear::{check_values, FactorInfo, FaerDirect, FaerDirectOptions, Fac
 /// A kept factorization gets at most this many times `reuse_below` GMRES
 /// iterations before `S` is factored anew (a tangent that moved far from it).
 pub const KEPT_BUDGET_FACTOR: usize = 4;
+
+/// GMRES iterations a fresh single-precision factor gets before the tangent is
+/// factored in double precision: a factor that needs more preconditions poorly
+/// (κ ε₃₂ above ~0.15; the Parisch blocks need 5 to the round-off floor), and
+/// the double factorization costs less than the iterations it saves.
+pub const SINGLE_BUDGET: usize = 20;
 
 /// GMRES on `K`, preconditioned by the factorization of `(K + Kᵀ)/2`.
 pub struct SymmetricPartGmres {
@@ -197,13 +214,14 @@ impl SymmetricPartGmres {
         GmresSettings { max_iterations: self.settings.max_iterations.min(budget), ..self.settings }
     }
 
-    /// Factor `S` of the stored values: `S[p] = (K[p] + Kᵀ[p]) / 2`.
-    fn factor_symmetric(&mut self) -> Result<Factorization, LinearSolverError> {
+    /// Factor `S` of the stored values: `S[p] = (K[p] + Kᵀ[p]) / 2` (in double
+    /// precision when `double`, else in the options' precision).
+    fn factor_symmetric(&mut self, double: bool) -> Result<Factorization, LinearSolverError> {
         let mut s = std::mem::take(&mut self.s_values);
         let vt = &self.values_t;
         s.clear();
         s.extend(self.transpose.iter().zip(vt).map(|(&q, at)| 0.5 * (vt[q as usize] + at)));
-        let result = self.factor_and_hold(&s);
+        let result = self.factor_and_hold(&s, double);
         self.s_values = s;
         result
     }
@@ -249,57 +267,101 @@ impl SymmetricPartGmres {
             _ => {
                 // the copy of an earlier K goes before the factorization (peak memory)
                 self.values_t = Vec::new();
-                self.factor_and_hold(values)
+                let method = self.factor_and_hold(values, false)?;
+                if !self.symmetric.solves_exactly() {
+                    // GMRES makes a single-precision factor's solves exact: it needs K
+                    self.values_t.extend_from_slice(values);
+                }
+                Ok(method)
             }
         }
     }
 
     /// Factor `values` (a symmetric tangent `K` itself, or the symmetric part `S`
-    /// of a general one) and hold the factorization.
-    fn factor_and_hold(&mut self, values: &[f64]) -> Result<Factorization, LinearSolverError> {
+    /// of a general one) and hold the factorization; in double precision when
+    /// `double`, else in the options' precision.
+    fn factor_and_hold(&mut self, values: &[f64], double: bool) -> Result<Factorization, LinearSolverError> {
         self.held = None;
-        let info = self.symmetric.factor(values)?;
+        let info = if double { self.symmetric.factor_in_double(values)? } else { self.symmetric.factor(values)? };
         self.held = Some(info.method);
         self.fresh = true;
         self.n_numeric += 1;
         Ok(info.method)
     }
 
-    /// `solve_in_place` of a symmetric tangent: directly with a fresh factorization
-    /// (the direct solver's operations, bit for bit); by GMRES with a kept one, and
-    /// when that misses its budget, directly after factoring the current `K`.
+    /// `solve_in_place` of a symmetric tangent: directly with a fresh
+    /// double-precision factorization (the direct solver's operations, bit for
+    /// bit); by GMRES with a kept one or a single-precision one. A kept one that
+    /// misses its budget is factored anew and the solve repeated; a
+    /// single-precision one that misses, in double precision, which solves
+    /// directly.
     fn solve_symmetric_tangent(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolverError> {
-        if self.fresh {
+        if self.fresh && self.symmetric.solves_exactly() {
             self.last_iterations = 0;
             self.last = SolveReport::default();
             return self.symmetric.solve_in_place(rhs);
         }
         self.rhs.clear();
         self.rhs.extend_from_slice(rhs);
-        let outcome = self.run_gmres(rhs, self.kept_settings());
-        let iterations = outcome.as_ref().map_or(0, |o| o.iterations);
+        // a fresh single-precision factor stands for a direct solve: GMRES to the
+        // round-off floor a direct solve reaches (the floor stops it), not only to
+        // the tolerance; with a tolerance of 1e-12 the patch tests' pressures were
+        // exact to 2e-8 instead of 1e-11 (κ times the residual)
+        let settings = if self.fresh { self.fresh_single_settings() } else { self.kept_settings() };
+        let mut iterations = 0;
+        let mut converged = self.gmres_converged(rhs, settings, &mut iterations);
+        let mut result = Ok(());
+        if !converged && !self.fresh {
+            // the tangent moved far from the kept factorization: factor it
+            result = self.refactor_and_solve(rhs, false, &mut iterations).map(|done| converged = done);
+        }
+        if result.is_ok() && !converged {
+            // a single-precision factor that does not make GMRES converge: double
+            result = self.refactor_and_solve(rhs, true, &mut iterations).map(|_| ());
+        }
         self.n_krylov += iterations;
         self.last = SolveReport { krylov_iterations: iterations, fallback: None };
-        let result = if matches!(outcome, Ok(o) if o.converged) {
-            self.last_iterations = iterations;
-            Ok(())
-        } else {
-            // the tangent moved far from the kept factorization: factor it (its
-            // values, the copy, go with it)
-            let t = Instant::now();
-            let k = std::mem::take(&mut self.values_t);
-            let refactored = self.factor_and_hold(&k);
-            drop(k);
-            self.numeric_time += t.elapsed();
-            refactored.and_then(|_| {
-                rhs.copy_from_slice(&self.rhs);
-                self.last_iterations = 0;
-                self.symmetric.solve_in_place(rhs)
-            })
-        };
+        if self.fresh && self.symmetric.solves_exactly() {
+            self.last_iterations = 0;
+        }
         // K's copy is not needed until the next kept solve (peak memory)
         self.values_t = Vec::new();
         result
+    }
+
+    /// The GMRES settings of a symmetric tangent's solve with its fresh
+    /// single-precision factor: to the round-off floor, within [`SINGLE_BUDGET`].
+    fn fresh_single_settings(&self) -> GmresSettings {
+        GmresSettings { tolerance: f64::EPSILON, max_iterations: self.settings.max_iterations.min(SINGLE_BUDGET), ..self.settings }
+    }
+
+    /// GMRES on the stored `K` and right-hand side `self.rhs` into `x`; whether it
+    /// converged (its iterations added to `iterations`, and kept as the last
+    /// solve's for the decision to keep the factorization).
+    fn gmres_converged(&mut self, x: &mut [f64], settings: GmresSettings, iterations: &mut usize) -> bool {
+        let outcome = self.run_gmres(x, settings);
+        let its = outcome.as_ref().map_or(0, |o| o.iterations);
+        *iterations += its;
+        self.last_iterations = its;
+        matches!(outcome, Ok(o) if o.converged)
+    }
+
+    /// Factor the stored symmetric tangent `K` anew (in double precision when
+    /// `double`) and solve `K x = self.rhs` into `x`: directly when the new factor
+    /// is exact, by GMRES otherwise. Whether the solve converged.
+    fn refactor_and_solve(&mut self, x: &mut [f64], double: bool, iterations: &mut usize) -> Result<bool, LinearSolverError> {
+        let t = Instant::now();
+        let k = std::mem::take(&mut self.values_t);
+        let refactored = self.factor_and_hold(&k, double);
+        self.values_t = k;
+        self.numeric_time += t.elapsed();
+        refactored?;
+        x.copy_from_slice(&self.rhs);
+        if self.symmetric.solves_exactly() {
+            self.symmetric.solve_in_place(x)?;
+            return Ok(true);
+        }
+        Ok(self.gmres_converged(x, self.fresh_single_settings(), iterations))
     }
 }
 
@@ -415,7 +477,7 @@ impl LinearSolver for SymmetricPartGmres {
                     self.n_reused += 1;
                     method
                 }
-                _ => match self.factor_symmetric() {
+                _ => match self.factor_symmetric(false) {
                     Ok(method) => method,
                     Err(e) => {
                         self.factor_lu(format!("the symmetric part could not be factored ({e})"))?;
@@ -464,7 +526,18 @@ impl LinearSolver for SymmetricPartGmres {
         if !matches!(outcome, Ok(o) if o.converged) && !self.fresh {
             // a held factorization of an earlier S: factor the current one and retry
             let t = Instant::now();
-            let refactored = self.factor_symmetric();
+            let refactored = self.factor_symmetric(false);
+            self.numeric_time += t.elapsed();
+            if refactored.is_ok() {
+                outcome = self.run_gmres(rhs, self.settings);
+                iterations += outcome.as_ref().map_or(0, |o| o.iterations);
+            }
+        }
+        if !matches!(outcome, Ok(o) if o.converged) && self.held.is_some() && !self.symmetric.solves_exactly() {
+            // a single-precision factor of S that does not precondition K well
+            // enough: S in double precision, and retry before LU
+            let t = Instant::now();
+            let refactored = self.factor_symmetric(true);
             self.numeric_time += t.elapsed();
             if refactored.is_ok() {
                 outcome = self.run_gmres(rhs, self.settings);
@@ -528,6 +601,7 @@ impl LinearSolver for SymmetricPartGmres {
 mod tests {
     use super::*;
     use crate::solver::bench::{elastic_cube_system, relative_residual};
+    use crate::solver::linear::FactorPrecision;
 
     /// The elastic cube's stiffness plus a skew part of relative size `skew` on the
     /// couplings between the x and y dofs of neighbouring nodes (friction-like).
@@ -712,6 +786,74 @@ mod tests {
         s.begin_increment();
         s.factor(&v).unwrap();
         assert!(s.fresh);
+    }
+
+    #[test]
+    fn a_single_precision_factor_solves_every_system_by_gmres_to_the_tolerance() {
+        let single = FaerDirectOptions { precision: FactorPrecision::Single, ..Default::default() };
+        // a symmetric tangent: the fresh factor preconditions, GMRES makes it exact,
+        // and K is copied for it
+        let (p, v, b) = skewed(0.0);
+        let mut s = SymmetricPartGmres::with_reuse(GmresSettings::default(), single, 8);
+        s.analyse(p.as_ref(), Symmetry::Symmetric).unwrap();
+        assert_eq!(s.factor(&v).unwrap().method, Factorization::Llt);
+        assert!(!s.symmetric.solves_exactly() && s.values_t.len() == v.len());
+        let mut x = b.clone();
+        s.solve_in_place(&mut x).unwrap();
+        let its = s.last_solve().krylov_iterations;
+        assert!(residual(&p, &v, &x, &b) <= 1e-12 && (1..=8).contains(&its), "{its} iterations");
+        // kept for a nearby tangent, as a double one is
+        let v2 = scale_diagonal(&p, &v, |j| 1.0 + 0.005 * ((j % 7) as f64) / 7.0);
+        s.factor(&v2).unwrap();
+        let mut x = b.clone();
+        s.solve_in_place(&mut x).unwrap();
+        assert!(residual(&p, &v2, &x, &b) <= 1e-12 && !s.fresh);
+        assert_eq!((s.timings().n_numeric, s.timings().n_reused, s.timings().n_fallback), (1, 1, 0));
+        // GMRES that cannot converge with the single factor (one iteration allowed):
+        // K factored again in double, which solves directly
+        let mut s = SymmetricPartGmres::with_reuse(GmresSettings { max_iterations: 1, ..Default::default() }, single, 8);
+        s.analyse(p.as_ref(), Symmetry::Symmetric).unwrap();
+        s.factor(&v).unwrap();
+        let mut x = b.clone();
+        s.solve_in_place(&mut x).unwrap();
+        assert!(s.symmetric.solves_exactly() && residual(&p, &v, &x, &b) <= 1e-12);
+        assert_eq!(s.timings().n_numeric, 2);
+        // a free chain of unit springs, each node held by 1e-9 of one (κ ≈ 4e9):
+        // singular in f32 (2 + 1e-9 rounds to 2); whether the pivot check or
+        // GMRES's budget refuses the single factor, the solve is the double one's
+        let n: usize = 3000;
+        let (mut col_ptr, mut row_idx, mut v) = (vec![0], vec![], vec![]);
+        for j in 0..n {
+            for i in j.saturating_sub(1)..(j + 2).min(n) {
+                row_idx.push(i);
+                v.push(if i != j { -1.0 } else if j == 0 || j == n - 1 { 1.0 + 1e-9 } else { 2.0 + 1e-9 });
+            }
+            col_ptr.push(row_idx.len());
+        }
+        let p = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
+        let b: Vec<f64> = (0..n).map(|i| ((i % 11) as f64 - 5.0) / 5.0).collect();
+        let mut s = SymmetricPartGmres::with_reuse(GmresSettings::default(), single, 8);
+        s.analyse(p.as_ref(), Symmetry::Symmetric).unwrap();
+        s.factor(&v).unwrap();
+        let mut x = b.clone();
+        s.solve_in_place(&mut x).unwrap();
+        let mut direct = FaerDirect::default();
+        direct.analyse(p.as_ref(), Symmetry::Symmetric).unwrap();
+        direct.factor(&v).unwrap();
+        let mut y = b.clone();
+        direct.solve_in_place(&mut y).unwrap();
+        assert!(s.symmetric.solves_exactly() && x == y, "{:?}", s.last_solve());
+        assert!(s.last_solve().krylov_iterations <= SINGLE_BUDGET);
+        // a frictional tangent: S in single precision, GMRES, no LU
+        let (p, v, b) = skewed(0.05);
+        let mut s = SymmetricPartGmres::new(GmresSettings::default(), single);
+        s.analyse(p.as_ref(), Symmetry::General).unwrap();
+        s.factor(&v).unwrap();
+        assert!(!s.symmetric.solves_exactly());
+        let mut x = b.clone();
+        s.solve_in_place(&mut x).unwrap();
+        assert!(residual(&p, &v, &x, &b) <= 1e-12, "{:?}", s.last_solve());
+        assert_eq!((s.timings().n_fallback, s.last_solve().fallback), (0, None));
     }
 
     #[test]

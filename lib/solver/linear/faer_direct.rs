@@ -82,11 +82,45 @@ pub struct FaerDirectOptions {
     /// instead of faer's numeric supernodal factorization (sequential over the
     /// supernodes). Both fill the same factor layout; `LDLᵀ` is always faer's.
     pub elimination_tree: bool,
+    /// Precision of the `LLᵀ` factor's values ([`FactorPrecision`]).
+    pub precision: FactorPrecision,
 }
+
+/// Precision of the values of the `LLᵀ` factor.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum FactorPrecision {
+    /// `f64`: the solves are exact to round-off.
+    #[default]
+    Double,
+    /// `f32` for the tree factorization's `LLᵀ` (of the matrix scaled by a power of
+    /// two near its largest diagonal entry's inverse, so that any unit system
+    /// stays inside `f32`'s range): half the memory and memory traffic of the
+    /// factor and its solves, twice the SIMD lanes. The solves are then accurate
+    /// only to about κ · 6e-8: a preconditioner, for a Krylov method that makes
+    /// them exact ([`FaerDirect::solves_exactly`]). A factorization that meets a
+    /// non-positive or a small pivot in `f32` (below [`SINGLE_PIVOT_FLOOR`] of its
+    /// diagonal entry: κ too large for `f32`) is made in `f64` instead, as is
+    /// every `LDLᵀ`.
+    Single,
+}
+
+/// A single-precision `LLᵀ` pivot `L_jj²` below this fraction of its (scaled)
+/// diagonal entry sends the factorization to double precision: the matrix is too
+/// ill-conditioned, or too close to singular, for an `f32` factor to precondition
+/// it (and the singularity check, [`FaerDirectOptions::singular_pivot_tolerance`],
+/// is made on the double one).
+pub const SINGLE_PIVOT_FLOOR: f64 = 1e-5;
 
 impl Default for FaerDirectOptions {
     fn default() -> Self {
-        Self { par: None, symmetric: SymmetricStrategy::LltThenLdlt, singular_pivot_tolerance: 1e-13, ordering: FillOrdering::default(), elimination_tree: true }
+        Self {
+            par: None,
+            symmetric: SymmetricStrategy::LltThenLdlt,
+            singular_pivot_tolerance: 1e-13,
+            ordering: FillOrdering::default(),
+            elimination_tree: true,
+            precision: FactorPrecision::Double,
+        }
     }
 }
 
@@ -110,6 +144,8 @@ enum Symbolic {
 enum Numeric {
     None,
     Llt,
+    /// `LLᵀ` of `scale · A` in `f32` ([`FactorPrecision::Single`]).
+    LltSingle { scale: f64 },
     Ldlt,
     Lu(Box<NumericLu<usize, f64>>),
 }
@@ -125,6 +161,8 @@ pub struct FaerDirect {
     numeric: Numeric,
     /// Values of the Cholesky-type factor.
     l_values: Vec<f64>,
+    /// Values of a single-precision `LLᵀ` factor (only one of the two is held).
+    l_values32: Vec<f32>,
     /// Columns of the widest supernode of the Cholesky-type symbolic factor (0 for
     /// none or LU): decides the automatic parallelism ([`PARALLEL_SUPERNODE`]).
     widest_supernode: usize,
@@ -161,6 +199,7 @@ impl FaerDirect {
             symbolic: None,
             numeric: Numeric::None,
             l_values: Vec::new(),
+            l_values32: Vec::new(),
             widest_supernode: 0,
             tree: None,
             lower_nnz: 0,
@@ -182,7 +221,7 @@ impl FaerDirect {
     pub fn factorization(&self) -> Option<Factorization> {
         match self.numeric {
             Numeric::None => None,
-            Numeric::Llt => Some(Factorization::Llt),
+            Numeric::Llt | Numeric::LltSingle { .. } => Some(Factorization::Llt),
             Numeric::Ldlt => Some(Factorization::Ldlt),
             Numeric::Lu(_) => Some(Factorization::Lu),
         }
@@ -194,6 +233,21 @@ impl FaerDirect {
             (Some(Symbolic::Cholesky(s)), _) => s.len_val(),
             _ => 0,
         }
+    }
+
+    /// Whether a solve with the factor held is exact to round-off (`false` for a
+    /// single-precision `LLᵀ`: a preconditioner).
+    pub fn solves_exactly(&self) -> bool {
+        !matches!(self.numeric, Numeric::LltSingle { .. })
+    }
+
+    /// `factor` in double precision whatever [`FaerDirectOptions::precision`] says
+    /// (a single-precision factor that did not precondition well enough).
+    pub fn factor_in_double(&mut self, values: &[f64]) -> Result<FactorInfo, LinearSolverError> {
+        let precision = std::mem::replace(&mut self.options.precision, FactorPrecision::Double);
+        let result = self.factor(values);
+        self.options.precision = precision;
+        result
     }
 
     /// Columns of the widest supernode of the Cholesky-type factor (0 if none; set
@@ -213,7 +267,7 @@ impl FaerDirect {
         self.options.par.unwrap_or_else(|| if self.widest_supernode >= PARALLEL_SUPERNODE { faer::get_global_parallelism() } else { Par::Seq })
     }
 
-    fn factor_cholesky(&mut self, values: &[f64]) -> Result<Factorization, LinearSolverError> {
+    fn factor_cholesky(&mut self, values: &[f64]) -> Result<Numeric, LinearSolverError> {
         let par = self.par();
         let (Some(pattern), Some(Symbolic::Cholesky(sym))) = (&self.pattern, &self.symbolic) else {
             return Err(LinearSolverError::Order("factor", "analyse"));
@@ -258,15 +312,28 @@ impl FaerDirect {
                         }
                         None => a,
                     };
+                    let dense_par = self.options.par.unwrap_or_else(faer::get_global_parallelism);
                     // the tasks write every block: no zeroing pass here, and the pages of a
                     // new factor are first touched in parallel (calloc'd, not written)
+                    if let (FactorPrecision::Single, Some(scale)) = (self.options.precision, single_scale(values, &self.diag_pos)) {
+                        // the double factor goes first (peak memory)
+                        self.l_values = Vec::new();
+                        if self.l_values32.len() != sym.len_val() {
+                            self.l_values32 = vec![0.0; sym.len_val()];
+                        }
+                        let factored = tree.factor_scaled(s, a_lower, scale, &mut self.l_values32, dense_par).is_ok();
+                        if factored && single_pivots_hold(sym, &self.l_values32, values, &self.diag_pos, scale, orig) {
+                            return Ok(Numeric::LltSingle { scale });
+                        }
+                    }
+                    self.l_values32 = Vec::new();
                     if self.l_values.len() != sym.len_val() {
                         self.l_values = vec![0.0; sym.len_val()];
                     }
-                    let dense_par = self.options.par.unwrap_or_else(faer::get_global_parallelism);
                     tree.factor(s, a_lower, &mut self.l_values, dense_par)
                 }
                 None => {
+                    self.l_values32 = Vec::new();
                     self.l_values.resize(sym.len_val(), 0.0);
                     let mut buf = MemBuffer::try_new(sym.factorize_numeric_llt_scratch::<f64>(par, Default::default()))
                         .map_err(|e| LinearSolverError::Faer(format!("{e:?}")))?;
@@ -292,6 +359,7 @@ impl FaerDirect {
             }
         }
         if method == Factorization::Ldlt {
+            self.l_values32 = Vec::new();
             self.l_values.resize(sym.len_val(), 0.0);
             let mut buf = MemBuffer::try_new(sym.factorize_numeric_ldlt_scratch::<f64>(par, Default::default()))
                 .map_err(|e| LinearSolverError::Faer(format!("{e:?}")))?;
@@ -328,13 +396,32 @@ impl FaerDirect {
                 }
             }
         }
-        Ok(method)
+        Ok(if method == Factorization::Llt { Numeric::Llt } else { Numeric::Ldlt })
     }
+}
+
+/// The scale of a single-precision factorization: the power of two nearest the
+/// inverse of the largest diagonal entry (`None` when there is none, or it is
+/// not a positive finite number).
+fn single_scale(values: &[f64], diag_pos: &[usize]) -> Option<f64> {
+    let largest = diag_pos.iter().filter(|&&p| p != usize::MAX).map(|&p| values[p]).fold(0.0, f64::max);
+    (largest.is_finite() && largest > 0.0).then(|| 2f64.powi(-(largest.log2().round() as i32)))
+}
+
+/// Whether every pivot `L_jj²` of a single-precision factor of `scale · A` is
+/// finite and at least [`SINGLE_PIVOT_FLOOR`] of its diagonal entry `scale · a_jj`.
+fn single_pivots_hold(sym: &SymbolicCholesky<usize>, l_values: &[f32], values: &[f64], diag_pos: &[usize], scale: f64, orig: impl Fn(usize) -> usize) -> bool {
+    factor_diagonal(sym, l_values).iter().enumerate().all(|(j, &l)| {
+        let p = diag_pos[orig(j)];
+        let a_jj = if p == usize::MAX { 0.0 } else { scale * values[p] };
+        let d = l * l;
+        d.is_finite() && d > 0.0 && d >= SINGLE_PIVOT_FLOOR * a_jj
+    })
 }
 
 /// Diagonal of a Cholesky-type factor in the permuted order: `L_jj` for `LLᵀ`,
 /// `D_jj` for `LDLᵀ` (both are stored on the factor's diagonal).
-fn factor_diagonal(sym: &SymbolicCholesky<usize>, values: &[f64]) -> Vec<f64> {
+fn factor_diagonal<T: super::tree_cholesky::FactorReal>(sym: &SymbolicCholesky<usize>, values: &[T]) -> Vec<f64> {
     let n = sym.nrows();
     let mut diag = vec![0.0; n];
     match sym.raw() {
@@ -344,7 +431,7 @@ fn factor_diagonal(sym: &SymbolicCholesky<usize>, values: &[f64]) -> Vec<f64> {
             for (j, d) in diag.iter_mut().enumerate() {
                 let (lo, hi) = (f.col_ptr()[j], f.col_ptr()[j + 1]);
                 if let Some(k) = f.row_idx()[lo..hi].iter().position(|&r| r == j) {
-                    *d = l.values()[lo + k];
+                    *d = l.values()[lo + k].to_f64();
                 }
             }
         }
@@ -354,7 +441,7 @@ fn factor_diagonal(sym: &SymbolicCholesky<usize>, values: &[f64]) -> Vec<f64> {
                 let node = l.supernode(sn);
                 let (start, m) = (node.start(), node.val());
                 for k in 0..m.ncols() {
-                    diag[start + k] = m[(k, k)];
+                    diag[start + k] = m[(k, k)].to_f64();
                 }
             }
         }
@@ -414,8 +501,9 @@ impl LinearSolver for FaerDirect {
         let start = Instant::now();
         self.numeric = Numeric::None;
         let result = match &self.symbolic {
-            Some(Symbolic::Cholesky(_)) => self.factor_cholesky(values).inspect(|&m| {
-                self.numeric = if m == Factorization::Llt { Numeric::Llt } else { Numeric::Ldlt };
+            Some(Symbolic::Cholesky(_)) => self.factor_cholesky(values).map(|numeric| {
+                self.numeric = numeric;
+                if matches!(self.numeric, Numeric::Ldlt) { Factorization::Ldlt } else { Factorization::Llt }
             }),
             Some(Symbolic::Lu(sym)) => {
                 let par = self.par();
@@ -478,6 +566,7 @@ impl FaerDirect {
         self.pattern = None;
         self.diag_pos = Vec::new();
         self.l_values = Vec::new();
+        self.l_values32 = Vec::new();
         self.widest_supernode = 0;
         self.tree = None;
         self.lower_nnz = 0;
@@ -501,18 +590,31 @@ impl FaerDirect {
             return Err(LinearSolverError::Dimension { what: "right-hand side entries", expected: n, got: rhs.len() });
         }
         let faer_err = |e: faer::dyn_stack::mem::AllocError| LinearSolverError::Faer(format!("{e:?}"));
-        let x = MatMut::from_column_major_slice_mut(rhs, n, 1);
         match (&self.symbolic, &self.numeric) {
             (Some(Symbolic::Cholesky(sym)), Numeric::Llt) => {
+                let x = MatMut::from_column_major_slice_mut(rhs, n, 1);
                 let mut buf = MemBuffer::try_new(sym.solve_in_place_scratch::<f64>(1, par)).map_err(faer_err)?;
                 LltRef::new(sym, &self.l_values).solve_in_place_with_conj(Conj::No, x, par, MemStack::new(&mut buf));
             }
+            (Some(Symbolic::Cholesky(sym)), &Numeric::LltSingle { scale }) => {
+                // A⁻¹ b = scale (scale A)⁻¹ b, with b scaled by a power of two into f32's range
+                let largest = rhs.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                let b_scale = if largest > 0.0 && largest.is_finite() { 2f64.powi(-(largest.log2().round() as i32)) } else { 1.0 };
+                let mut x32: Vec<f32> = rhs.iter().map(|&v| (v * b_scale) as f32).collect();
+                let mut buf = MemBuffer::try_new(sym.solve_in_place_scratch::<f32>(1, par)).map_err(faer_err)?;
+                let x = MatMut::from_column_major_slice_mut(&mut x32, n, 1);
+                LltRef::new(sym, &self.l_values32).solve_in_place_with_conj(Conj::No, x, par, MemStack::new(&mut buf));
+                let back = scale / b_scale;
+                rhs.iter_mut().zip(&x32).for_each(|(r, &v)| *r = back * f64::from(v));
+            }
             (Some(Symbolic::Cholesky(sym)), Numeric::Ldlt) => {
                 let mut buf = MemBuffer::try_new(sym.solve_in_place_scratch::<f64>(1, par)).map_err(faer_err)?;
+                let x = MatMut::from_column_major_slice_mut(rhs, n, 1);
                 LdltRef::new(sym, &self.l_values).solve_in_place_with_conj(Conj::No, x, par, MemStack::new(&mut buf));
             }
             (Some(Symbolic::Lu(sym)), Numeric::Lu(num)) => {
                 let mut buf = MemBuffer::try_new(sym.solve_in_place_scratch::<f64>(1, par)).map_err(faer_err)?;
+                let x = MatMut::from_column_major_slice_mut(rhs, n, 1);
                 LuRef::new_unchecked(sym, num).solve_in_place_with_conj(Conj::No, x, par, MemStack::new(&mut buf));
             }
             _ => return Err(LinearSolverError::Order("solve_in_place", "a successful factor")),

@@ -22,5 +22,5 @@ pub mod tree_cholesky;
 pub mod interface;
 
 pub use error::LinearSolverError;
-pub use faer_direct::{FaerDirect, FaerDirectOptions, SymmetricStrategy, PARALLEL_SUPERNODE};
+pub use faer_direct::{FactorPrecision, FaerDirect, FaerDirectOptions, SymmetricStrategy, PARALLEL_SUPERNODE, SINGLE_PIVOT_FLOOR};
 pub use interface::{check_values, FactorInfo, Factorization, LinearSolver, SolveReport, SolverTimings, Symmetry};

@@ -47,9 +47,9 @@ use super::stabilization::Stabilization;
 use crate::assembly::{Assembly, NodeGroups, Pattern, DOFS_PER_NODE};
 use crate::contact::pair::PairSolver;
 use crate::format::scres::IterationLog;
-use crate::format::setup::{LinearSolverChoice, LinearSolverSetup, NewtonSetup, OrderingChoice};
+use crate::format::setup::{LinearSolverChoice, LinearSolverSetup, NewtonSetup, OrderingChoice, PrecisionChoice};
 use crate::solver::gmres::GmresSettings;
-use crate::solver::linear::{FaerDirect, FaerDirectOptions, LinearSolver, SolverTimings, SymmetricStrategy, Symmetry};
+use crate::solver::linear::{FactorPrecision, FaerDirect, FaerDirectOptions, LinearSolver, SolverTimings, SymmetricStrategy, Symmetry};
 use crate::solver::ordering::FillOrdering;
 use crate::solver::symmetric_part::SymmetricPartGmres;
 use groups::{contact_groups, GroupOwner};
@@ -204,6 +204,16 @@ impl<'p> Newton<'p> {
                 OrderingChoice::NestedDissection => FillOrdering::NestedDissection,
                 OrderingChoice::Amd => FillOrdering::Amd,
             },
+            // a symmetric tangent's factor under `direct` / `gmres`, which GMRES makes
+            // exact; `cholesky` and `ldlt` solve directly, in double, and the
+            // symmetric part of a non-symmetric tangent stays double (a mildly
+            // non-symmetric system then converges in one GMRES iteration to
+            // round-off, which the mortar patch tests need; the frictional crossed
+            // beams gained nothing from single)
+            precision: match (choice, symmetry, linear_setup.factor_precision) {
+                (LinearSolverChoice::Auto | LinearSolverChoice::Direct | LinearSolverChoice::Gmres, Symmetry::Symmetric, PrecisionChoice::Single) => FactorPrecision::Single,
+                _ => FactorPrecision::Double,
+            },
             ..Default::default()
         };
         let gmres = GmresSettings { tolerance: linear_setup.gmres_tolerance, max_iterations: linear_setup.gmres_max_iterations as usize, ..Default::default() };
@@ -227,8 +237,9 @@ impl<'p> Newton<'p> {
         let n_free = pattern.n_free();
         let stabilization = Stabilization::new(problem, &contact);
         // Inexact Newton for the iterative solves of a non-symmetric tangent and
-        // PETSc's; a symmetric tangent's kept factorization solves to the GMRES
-        // tolerance, so Newton's iterates are the direct solve's.
+        // PETSc's; a symmetric tangent's factorization (fresh or kept, single or
+        // double precision) solves to the GMRES tolerance, so Newton's iterates are
+        // the direct solve's up to round-off.
         let iterative = petsc || symmetry == Symmetry::General;
         let forcing = (linear_setup.inexact_newton && iterative).then(|| Forcing::new(FORCING_MAX, settings.residual_tolerance));
         Ok(Self {

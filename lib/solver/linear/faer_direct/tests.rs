@@ -340,3 +340,80 @@ fn the_background_analysis_is_the_analysis() {
         assert!(residual_of(q, small.assembly.values(), &x, &small.rhs) < 1e-12);
     });
 }
+
+fn single() -> FaerDirect {
+    FaerDirect::new(FaerDirectOptions { precision: FactorPrecision::Single, ..Default::default() })
+}
+
+#[test]
+fn a_single_precision_factor_is_a_preconditioner_in_any_unit_system() {
+    let cube = elastic_cube_system(6).unwrap();
+    let p = cube.pattern.symbolic_owned();
+    let v = cube.assembly.values();
+    let b = &cube.rhs;
+    let (x64, _) = solve(&mut FaerDirect::default(), p, v, b, Symmetry::Symmetric);
+    let norm = x64.iter().map(|x| x * x).sum::<f64>().sqrt();
+    // the stiffness in any units: 1e±40 lies outside f32's range (1.2e-38 to
+    // 3.4e38), so only the factorization's scale keeps these factors finite
+    for units in [1.0, 1e40, 1e-40] {
+        let v: Vec<f64> = v.iter().map(|a| a * units).collect();
+        let mut s = single();
+        let (x, method) = solve(&mut s, p, &v, b, Symmetry::Symmetric);
+        assert_eq!(method, Factorization::Llt);
+        assert!(!s.solves_exactly(), "a single-precision factor at units {units:e}");
+        // f32's round-off 6e-8 times the cube's condition number (~1e3): not the
+        // double factor's 1e-15, and good enough to precondition (GMRES gains about
+        // three digits per iteration with it)
+        let r = residual_of(p, &v, &x, b);
+        assert!((1e-10..1e-3).contains(&r), "units {units:e}: residual {r:e}");
+        let d = x.iter().zip(&x64).map(|(a, b)| (a * units - b).powi(2)).sum::<f64>().sqrt();
+        assert!(d / norm < 1e-3, "units {units:e}: solution off by {:e}", d / norm);
+        // half the factor's bytes
+        assert!(s.l_values.is_empty() && s.l_values32.len() == s.factor_len());
+        // the same matrix in double precision when asked: exact
+        s.factor_in_double(&v).unwrap();
+        assert!(s.solves_exactly() && s.l_values32.is_empty());
+        let mut x = b.clone();
+        s.solve_in_place(&mut x).unwrap();
+        assert!(residual_of(p, &v, &x, b) < 1e-12);
+    }
+}
+
+#[test]
+fn a_factor_that_single_precision_cannot_hold_is_made_in_double() {
+    // Pairs of dofs joined by a spring that nearly cancels their own,
+    // [[1, 1 − δ], [1 − δ, 1]] with δ = 1e-6 (representable in f32: 17 ulps of 1):
+    // symmetric positive definite, and the second pivot of each pair is
+    // 1 − (1 − δ)² ≈ 2δ = 2e-6 of its diagonal entry, below SINGLE_PIVOT_FLOOR
+    let n: usize = 3000;
+    let delta = 1e-6;
+    let (mut col_ptr, mut row_idx, mut v) = (vec![0], vec![], vec![]);
+    for j in 0..n {
+        let pair = j - j % 2;
+        for i in pair..pair + 2 {
+            row_idx.push(i);
+            v.push(if i == j { 1.0 } else { 1.0 - delta });
+        }
+        col_ptr.push(row_idx.len());
+    }
+    let p = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
+    let b: Vec<f64> = (0..n).map(|i| ((i % 11) as f64 - 5.0) / 5.0).collect();
+    let mut s = single();
+    let (x, method) = solve(&mut s, &p, &v, &b, Symmetry::Symmetric);
+    assert_eq!(method, Factorization::Llt);
+    assert!(s.solves_exactly(), "a double-precision factor");
+    // the double factor's operations, bit for bit
+    let (x64, _) = solve(&mut FaerDirect::default(), &p, &v, &b, Symmetry::Symmetric);
+    assert_eq!(x, x64);
+    // and an indefinite matrix goes to LDLᵀ, in double, as without the option
+    let (p, v) = {
+        let d = saddle_point(40, 12);
+        dense_to_csc(&d, |i, j| d[i][j] != 0.0)
+    };
+    let b: Vec<f64> = (0..p.nrows()).map(|i| (i % 5) as f64 - 2.0).collect();
+    let mut s = single();
+    let (x, method) = solve(&mut s, &p, &v, &b, Symmetry::Symmetric);
+    assert_eq!(method, Factorization::Ldlt);
+    assert!(s.solves_exactly());
+    assert!(residual_of(&p, &v, &x, &b) < 1e-10);
+}
