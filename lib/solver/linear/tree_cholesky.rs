@@ -606,6 +606,21 @@ mod tests {
         for threads in [2, 3] {
             assert_eq!(one, bits(pb.tree_factor(threads, Par::Seq).unwrap()), "{threads} threads");
         }
+        // and in single precision, of the matrix scaled by a power of two
+        let single = |threads: usize| -> Vec<u32> {
+            let s = pb.supernodal();
+            let (cp, ri, val) = &pb.lower;
+            let n = pb.p.nrows();
+            let a_lower = SparseColMatRef::new(SymbolicSparseColMatRef::new_unsorted_checked(n, n, cp, None, ri), val);
+            let mut l = vec![0.0f32; s.len_val()];
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("a thread pool");
+            pool.install(|| TreeCholesky::new(s).factor_scaled(s, a_lower, 0.25, &mut l, Par::Seq)).unwrap();
+            l.into_iter().map(f32::to_bits).collect()
+        };
+        let one = single(1);
+        for threads in [2, 3] {
+            assert_eq!(one, single(threads), "{threads} threads, single precision");
+        }
     }
 
     #[test]
