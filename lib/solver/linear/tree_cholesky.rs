@@ -537,13 +537,19 @@ mod tests {
 
         /// The tree factorization's values, on `threads` rayon threads.
         fn tree_factor(&self, threads: usize, par: Par) -> Result<Vec<f64>, LltError> {
+            self.tree_factor_scaled(threads, par, 1.0)
+        }
+
+        /// The tree factorization of `scale · A` in any precision, on `threads`
+        /// rayon threads.
+        fn tree_factor_scaled<T: FactorReal>(&self, threads: usize, par: Par, scale: f64) -> Result<Vec<T>, LltError> {
             let s = self.supernodal();
             let (cp, ri, val) = &self.lower;
             let n = self.p.nrows();
             let a_lower = SparseColMatRef::new(SymbolicSparseColMatRef::new_unsorted_checked(n, n, cp, None, ri), val);
-            let mut l = vec![0.0; s.len_val()];
+            let mut l = vec![T::of_f64(0.0); s.len_val()];
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("a thread pool");
-            pool.install(|| TreeCholesky::new(s).factor(s, a_lower, &mut l, par))?;
+            pool.install(|| TreeCholesky::new(s).factor_scaled(s, a_lower, scale, &mut l, par))?;
             Ok(l)
         }
 
@@ -608,13 +614,7 @@ mod tests {
         }
         // and in single precision, of the matrix scaled by a power of two
         let single = |threads: usize| -> Vec<u32> {
-            let s = pb.supernodal();
-            let (cp, ri, val) = &pb.lower;
-            let n = pb.p.nrows();
-            let a_lower = SparseColMatRef::new(SymbolicSparseColMatRef::new_unsorted_checked(n, n, cp, None, ri), val);
-            let mut l = vec![0.0f32; s.len_val()];
-            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("a thread pool");
-            pool.install(|| TreeCholesky::new(s).factor_scaled(s, a_lower, 0.25, &mut l, Par::Seq)).unwrap();
+            let l: Vec<f32> = pb.tree_factor_scaled(threads, Par::Seq, 0.25).unwrap();
             l.into_iter().map(f32::to_bits).collect()
         };
         let one = single(1);
