@@ -691,6 +691,8 @@ fn analysis(owned: SymbolicSparseColMat<usize>, symmetry: Symmetry, options: Fae
             // block at least) factors in half the time (docs/performance.md).
             let params = CholeskySymbolicParams { supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL, ..Default::default() };
             let c = factorize_symbolic_cholesky(owned.as_ref(), Side::Lower, ordering, params).map_err(|e| LinearSolverError::Faer(format!("{e:?}")))?;
+            // sized in double even for a single-precision factor: one that f32 cannot
+            // hold is made in double
             crate::solver::memory::check_cholesky(c.len_val(), n, owned.compute_nnz()).map_err(LinearSolverError::TooLarge)?;
             Symbolic::Cholesky(c)
         }
