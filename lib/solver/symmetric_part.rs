@@ -48,12 +48,14 @@
 //! symmetric) is made in `f32`: half the bytes, so half the memory traffic of
 //! the factorization and of every triangular solve, and twice the SIMD lanes.
 //! Its solves are then accurate to about κ · 6e-8, so every solve, a fresh
-//! factor's included, is a GMRES solve with it as preconditioner, to the same
-//! tolerance, and Newton takes the inexact forcing terms of the frictional path.
-//! When GMRES does not converge with a fresh single-precision factor, `S` is
-//! factored in `f64` and the solve repeated (before the LU fallback); a factor
-//! that `f32` cannot hold (a non-positive or tiny pivot) is made in `f64` at once
-//! ([`FaerDirect`]).
+//! factor's included, is a GMRES solve with it as preconditioner: a fresh
+//! factor's of a symmetric tangent to the round-off floor a direct solve reaches
+//! (within [`SINGLE_BUDGET`] iterations), a kept one's as with a double factor.
+//! When GMRES does not converge with a fresh single-precision factor, the matrix
+//! is factored in `f64` and the solve repeated (before the LU fallback of a
+//! non-symmetric tangent); a factor that `f32` cannot hold (a non-positive or
+//! tiny pivot) is made in `f64` at once ([`FaerDirect`]). Newton asks it for a
+//! symmetric tangent only (`docs/theory/solver.md`).
 
 use std::time::{Duration, Instant};
 
