@@ -307,8 +307,9 @@ impl SymmetricPartGmres {
         self.rhs.extend_from_slice(rhs);
         // a fresh single-precision factor stands for a direct solve: GMRES to the
         // round-off floor a direct solve reaches (the floor stops it), not only to
-        // the tolerance; with a tolerance of 1e-12 the patch tests' pressures were
-        // exact to 2e-8 instead of 1e-11 (κ times the residual)
+        // the tolerance, which would leave a problem solved in one Newton
+        // iteration accurate to κ times 1e-12 (the mortar patch tests, with S in
+        // single in a trial: exact to 1.9e-8 instead of 1e-11)
         let settings = if self.fresh { self.fresh_single_settings() } else { self.kept_settings() };
         let mut iterations = 0;
         let mut converged = self.gmres_converged(rhs, settings, &mut iterations);
