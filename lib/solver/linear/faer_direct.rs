@@ -9,7 +9,10 @@
 //! dissection or AMD ordering ([`crate::solver::ordering`]), supernodal, its numeric
 //! part by [`super::tree_cholesky`], parallel over the elimination tree) for the symmetric positive definite tangent; when it
 //! meets a non-positive pivot, `LDLᵀ` on the same symbolic factorization
-//! (symmetric indefinite, no pivoting: fails only on a zero pivot).
+//! (symmetric indefinite, no pivoting: fails only on a zero pivot). The `LLᵀ`
+//! factor is in `f64`, or in `f32` with [`FactorPrecision::Single`] (a
+//! preconditioner whose solves a Krylov method makes exact; double whenever `f32`
+//! cannot hold it).
 //! [`Symmetry::General`]: `LU` with partial pivoting (COLAMD ordering). On 3D
 //! meshes its fill explodes (the frictional crossed beams at 109k dofs: 24 s and
 //! 8.2 GB for one LU), so the frictional tangent goes by default to
