@@ -318,8 +318,8 @@ fn integrate(
     // the spatial tangents' upper blocks, summed over the points (updated Lagrangian
     // and small strain; the total Lagrangian one adds into `k` itself)
     let mut spatial = SpatialStiffness::new();
-    let mut spatial_used = false;
     let linear = mat.is_geometrically_linear();
+    let spatial_used = linear || matches!(form, Formulation::UpdatedLagrangian);
     for (q, wq) in GAUSS_HEX_WEIGHTS.iter().enumerate() {
         let (G, det0) = gauss_reference(X, q)?;
         let w = wq * det0;
@@ -330,7 +330,6 @@ fn integrate(
                 let (sigma, c) = mat.stress_tangent(&F).map_err(err)?;
                 add_force_spatial(r, &G, &sigma, w);
                 spatial.add(&G, &c, None, w);
-                spatial_used = true;
             } else {
                 let sigma = mat.stress(&F).map_err(err)?;
                 add_force_spatial(r, &G, &sigma, w);
@@ -355,7 +354,6 @@ fn integrate(
                 add_force_spatial(r, &g, &sigma, dv);
                 if let Some(c) = c {
                     spatial.add(&g, &c, Some(&sigma), dv);
-                    spatial_used = true;
                 }
             }
             Formulation::TotalLagrangian => {

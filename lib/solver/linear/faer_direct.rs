@@ -407,7 +407,12 @@ impl FaerDirect {
 /// inverse of the largest diagonal entry (`None` when there is none, or it is
 /// not a positive finite number).
 fn single_scale(values: &[f64], diag_pos: &[usize]) -> Option<f64> {
-    let largest = diag_pos.iter().filter(|&&p| p != usize::MAX).map(|&p| values[p]).fold(0.0, f64::max);
+    inverse_power_of_two(diag_pos.iter().filter(|&&p| p != usize::MAX).map(|&p| values[p]).fold(0.0, f64::max))
+}
+
+/// The power of two nearest `1 / largest` (`None` unless `largest` is a positive
+/// finite number): a scale that moves values of that size near 1 exactly.
+fn inverse_power_of_two(largest: f64) -> Option<f64> {
     (largest.is_finite() && largest > 0.0).then(|| 2f64.powi(-(largest.log2().round() as i32)))
 }
 
@@ -602,7 +607,7 @@ impl FaerDirect {
             (Some(Symbolic::Cholesky(sym)), &Numeric::LltSingle { scale }) => {
                 // A⁻¹ b = scale (scale A)⁻¹ b, with b scaled by a power of two into f32's range
                 let largest = rhs.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-                let b_scale = if largest > 0.0 && largest.is_finite() { 2f64.powi(-(largest.log2().round() as i32)) } else { 1.0 };
+                let b_scale = inverse_power_of_two(largest).unwrap_or(1.0);
                 let mut x32: Vec<f32> = rhs.iter().map(|&v| (v * b_scale) as f32).collect();
                 let mut buf = MemBuffer::try_new(sym.solve_in_place_scratch::<f32>(1, par)).map_err(faer_err)?;
                 let x = MatMut::from_column_major_slice_mut(&mut x32, n, 1);
