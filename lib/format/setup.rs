@@ -338,13 +338,14 @@ pub enum OrderingChoice {
     Amd,
 }
 
-/// Precision of the Cholesky factor of `direct` and `gmres` (`auto`), which GMRES
-/// makes exact.
+/// Precision of a symmetric tangent's Cholesky factor under `direct`, `gmres` and
+/// `auto`, whose solves GMRES makes exact.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, Default)]
 #[serde(rename_all = "snake_case")]
 pub enum PrecisionChoice {
-    /// `f32` values: half the factor's memory and traffic; every solve by GMRES to
-    /// `gmres_tolerance`, and a factor that `f32` cannot hold is made in `f64`.
+    /// `f32` values: half the factor's memory and traffic; every solve by GMRES (a
+    /// fresh factor's to the round-off floor, a kept one's to `gmres_tolerance`),
+    /// and a factor that `f32` cannot hold is made in `f64`.
     #[default]
     Single,
     /// `f64` values: a fresh factor of a symmetric tangent solves directly.
@@ -356,8 +357,9 @@ pub enum PrecisionChoice {
 pub struct LinearSolverSetup {
     pub method: LinearSolverChoice,
     pub ordering: OrderingChoice,
-    /// Precision of the Cholesky factor of `direct` / `gmres` (`cholesky` and `ldlt`
-    /// always factor in double).
+    /// Precision of a symmetric tangent's Cholesky factor under `direct` / `gmres`
+    /// (`cholesky`, `ldlt` and the symmetric part of a non-symmetric tangent always
+    /// factor in double).
     pub factor_precision: PrecisionChoice,
     /// GMRES: relative residual ‖b − K x‖/‖b‖ to reach.
     pub gmres_tolerance: f64,
