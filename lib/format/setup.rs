@@ -336,6 +336,9 @@ pub enum OrderingChoice {
     NestedDissection,
     /// faer's approximate minimum degree.
     Amd,
+    /// Nested dissection by coordinate planes through the mesh (the node graph
+    /// cut at the median node along the longest side of each part).
+    Geometric,
 }
 
 /// Precision of a symmetric tangent's Cholesky factor under `direct`, `gmres` and
@@ -689,6 +692,8 @@ mod tests {
     fn linear_solver_as_a_word_or_a_map() {
         let s = SolveSetup::parse("s", "materials: []\nlinear_solver: gmres\n").unwrap();
         assert_eq!(s.linear_solver, LinearSolverChoice::Gmres.into());
+        let s = SolveSetup::parse("s", "materials: []\nlinear_solver: {ordering: geometric}\n").unwrap();
+        assert_eq!(s.linear_solver.ordering, OrderingChoice::Geometric);
         let s = SolveSetup::parse("s", "materials: []\nlinear_solver: {ordering: amd, gmres_tolerance: 1.0e-10}\n").unwrap();
         let d = LinearSolverSetup::default();
         assert_eq!(s.linear_solver, LinearSolverSetup { ordering: OrderingChoice::Amd, gmres_tolerance: 1e-10, ..d.clone() });

@@ -462,6 +462,11 @@ impl LinearSolver for SymmetricPartGmres {
         self.analyse_with(pattern, symmetry, true)
     }
 
+    fn set_unknown_coordinates(&mut self, coordinates: std::sync::Arc<[[f64; 3]]>) {
+        self.symmetric.set_unknown_coordinates(coordinates.clone());
+        self.lu.set_unknown_coordinates(coordinates);
+    }
+
     fn finish_analysis(&mut self) -> Result<(), LinearSolverError> {
         // the background thread's time joins this solver's analysis time
         let before = self.symmetric.timings().symbolic;

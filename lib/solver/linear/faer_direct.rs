@@ -40,6 +40,7 @@
 //! the same, bit for bit, for any number of rayon threads.
 
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use faer::dyn_stack::{MemBuffer, MemStack};
@@ -60,7 +61,7 @@ use faer::{Conj, MatMut, Par, Side};
 
 use super::error::LinearSolverError;
 use super::tree_cholesky::TreeCholesky;
-use crate::solver::ordering::{nested_dissection, FillOrdering};
+use crate::solver::ordering::{geometric_dissection, nested_dissection, FillOrdering};
 use super::interface::{check_values, FactorInfo, Factorization, LinearSolver, SolverTimings, Symmetry};
 
 /// Widest supernode (columns) from which [`FaerDirect`] runs faer in parallel when
@@ -179,6 +180,8 @@ pub struct FaerDirect {
     /// ([`LinearSolver::analyse_in_background`]); joined by `finish_analysis` or
     /// the next `factor`.
     pending: Option<std::thread::JoinHandle<Result<Analysis, LinearSolverError>>>,
+    /// Each unknown's node position, for [`FillOrdering::Geometric`].
+    coordinates: Option<Arc<[[f64; 3]]>>,
     symbolic_time: Duration,
     numeric_time: Duration,
     n_symbolic: usize,
@@ -207,6 +210,7 @@ impl FaerDirect {
             tree: None,
             lower_nnz: 0,
             pending: None,
+            coordinates: None,
             symbolic_time: Duration::ZERO,
             numeric_time: Duration::ZERO,
             n_symbolic: 0,
@@ -464,7 +468,7 @@ impl LinearSolver for FaerDirect {
 
     fn analyse(&mut self, pattern: SymbolicSparseColMatRef<'_, usize>, symmetry: Symmetry) -> Result<(), LinearSolverError> {
         let owned = self.take_pattern(pattern)?;
-        let done = analysis(owned, symmetry, self.options)?;
+        let done = analysis(owned, symmetry, self.options, self.coordinates.as_deref())?;
         self.install(done);
         Ok(())
     }
@@ -478,10 +482,11 @@ impl LinearSolver for FaerDirect {
         }
         let owned = self.take_pattern(pattern)?;
         let options = self.options;
+        let coordinates = self.coordinates.clone();
         let (tx, rx) = std::sync::mpsc::channel();
         let spawned = std::thread::Builder::new().name("sc-analysis".into()).spawn(move || {
             let pattern = rx.recv().map_err(|_| LinearSolverError::Faer("the analysis thread got no pattern".into()))?;
-            analysis(pattern, symmetry, options)
+            analysis(pattern, symmetry, options, coordinates.as_deref())
         });
         match spawned {
             Ok(handle) => {
@@ -490,9 +495,13 @@ impl LinearSolver for FaerDirect {
                 self.pending = Some(handle);
             }
             // no thread to be had: the analysis here
-            Err(_) => self.install(analysis(owned, symmetry, options)?),
+            Err(_) => self.install(analysis(owned, symmetry, options, self.coordinates.as_deref())?),
         }
         Ok(())
+    }
+
+    fn set_unknown_coordinates(&mut self, coordinates: Arc<[[f64; 3]]>) {
+        self.coordinates = Some(coordinates);
     }
 
     fn finish_analysis(&mut self) -> Result<(), LinearSolverError> {
@@ -674,7 +683,7 @@ impl FaerDirect {
 
 /// Ordering and symbolic factorization of `owned` (on any thread: it reads nothing
 /// but its arguments).
-fn analysis(owned: SymbolicSparseColMat<usize>, symmetry: Symmetry, options: FaerDirectOptions) -> Result<Analysis, LinearSolverError> {
+fn analysis(owned: SymbolicSparseColMat<usize>, symmetry: Symmetry, options: FaerDirectOptions, coordinates: Option<&[[f64; 3]]>) -> Result<Analysis, LinearSolverError> {
     let start = Instant::now();
     let n = owned.nrows();
     let diag_pos = (0..n)
@@ -688,6 +697,12 @@ fn analysis(owned: SymbolicSparseColMat<usize>, symmetry: Symmetry, options: Fae
             let perm = match options.ordering {
                 FillOrdering::Amd => None,
                 FillOrdering::NestedDissection => Some(nested_dissection(owned.as_ref())?),
+                // without the unknowns' positions (a caller that gave none) the
+                // graph's own nested dissection
+                FillOrdering::Geometric => Some(match coordinates {
+                    Some(x) => geometric_dissection(owned.as_ref(), x)?,
+                    None => nested_dissection(owned.as_ref())?,
+                }),
             };
             let ordering = match &perm {
                 None => SymmetricOrdering::Amd,

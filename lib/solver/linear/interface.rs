@@ -103,6 +103,10 @@ pub trait LinearSolver: Send {
     /// displacement vector, before `factor` (a multigrid backend builds its
     /// rigid-body near-null space from them); others ignore it.
     fn set_configuration(&mut self, _reference: &[nalgebra::Vector3<f64>], _u: &[f64]) {}
+    /// The position of each unknown's node (the free dofs in order), for an
+    /// ordering that cuts the mesh by planes (`FillOrdering::Geometric`); given
+    /// before the first `analyse`, kept for every later one. Others ignore it.
+    fn set_unknown_coordinates(&mut self, _coordinates: std::sync::Arc<[[f64; 3]]>) {}
     /// A load increment (or a cutback's new attempt) starts: the next `factor`
     /// keeps nothing from an earlier increment (no preconditioner reused across
     /// it), so that a restart from any converged increment, which starts with

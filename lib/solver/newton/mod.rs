@@ -203,6 +203,7 @@ impl<'p> Newton<'p> {
             ordering: match linear_setup.ordering {
                 OrderingChoice::NestedDissection => FillOrdering::NestedDissection,
                 OrderingChoice::Amd => FillOrdering::Amd,
+                OrderingChoice::Geometric => FillOrdering::Geometric,
             },
             // a symmetric tangent's factor under `direct` / `gmres`, which GMRES makes
             // exact; `cholesky` and `ldlt` solve directly, in double, and the
@@ -232,6 +233,12 @@ impl<'p> Newton<'p> {
         };
         // the first analysis runs while the first tangent is assembled; the first
         // factorization waits for it (`solve_increment`)
+        // each unknown's node position, for an ordering by coordinate planes
+        let unknowns: std::sync::Arc<[[f64; 3]]> = problem.dofs.global_of_free().iter().map(|&g| {
+            let x = &problem.X[g as usize / DOFS_PER_NODE];
+            [x[0], x[1], x[2]]
+        }).collect();
+        linear.set_unknown_coordinates(unknowns);
         linear.analyse_in_background(pattern.symbolic(), symmetry)?;
         let n = DOFS_PER_NODE * problem.n_nodes();
         let n_free = pattern.n_free();

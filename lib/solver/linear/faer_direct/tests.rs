@@ -417,3 +417,36 @@ fn a_factor_that_single_precision_cannot_hold_is_made_in_double() {
     assert!(s.solves_exactly());
     assert!(residual_of(&p, &v, &x, &b) < 1e-10);
 }
+
+/// `ordering: geometric` is the factorization's ordering when the unknowns'
+/// positions are given: the same solution as METIS's to round-off, another factor
+/// (its size is the geometric ordering's); without positions it is METIS's.
+#[test]
+fn the_geometric_ordering_orders_the_factorization_when_given_positions() {
+    let n = 6;
+    let cube = elastic_cube_system(n).unwrap();
+    let (nodes, _) = crate::assembly::pattern::structured_hex_grid(n, n, n);
+    let positions: Arc<[[f64; 3]]> = cube.pattern.dofs().global_of_free().iter().map(|&g| nodes[g as usize / 3]).collect();
+    let p = cube.pattern.symbolic_owned();
+    let v = cube.assembly.values();
+    let b = &cube.rhs;
+    let geometric = FaerDirectOptions { ordering: FillOrdering::Geometric, ..Default::default() };
+    let mut metis = FaerDirect::default();
+    let (x_metis, _) = solve(&mut metis, p, v, b, Symmetry::Symmetric);
+    let mut with_positions = FaerDirect::new(geometric);
+    with_positions.set_unknown_coordinates(positions.clone());
+    let (x_geo, _) = solve(&mut with_positions, p, v, b, Symmetry::Symmetric);
+    let norm = x_metis.iter().map(|v| v * v).sum::<f64>().sqrt();
+    let d = x_geo.iter().zip(&x_metis).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt();
+    assert!(d / norm < 1e-12, "solutions differ by {:e}", d / norm);
+    let geometric_len = {
+        let perm = crate::solver::ordering::geometric_dissection(p.as_ref(), &positions).unwrap();
+        let o = faer::sparse::linalg::cholesky::SymmetricOrdering::Custom(PermRef::new_checked(&perm.forward, &perm.inverse, p.ncols()));
+        factorize_symbolic_cholesky(p.as_ref(), Side::Lower, o, CholeskySymbolicParams::default()).unwrap().len_val()
+    };
+    assert_eq!(with_positions.factor_len(), geometric_len);
+    assert_ne!(with_positions.factor_len(), metis.factor_len(), "the cube's two orderings fill differently (measured)");
+    let mut without = FaerDirect::new(geometric);
+    solve(&mut without, p, v, b, Symmetry::Symmetric);
+    assert_eq!(without.factor_len(), metis.factor_len());
+}

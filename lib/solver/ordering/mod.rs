@@ -27,6 +27,9 @@
 use super::linear::error::LinearSolverError;
 use faer::sparse::SymbolicSparseColMatRef;
 
+pub mod geometric;
+pub use geometric::geometric_dissection;
+
 /// Serialises the calls into METIS (its random generator is a process global).
 static METIS_LOCK: std::sync::Mutex<()> = std::sync::Mutex::new(());
 
@@ -38,6 +41,9 @@ pub enum FillOrdering {
     /// METIS nested dissection on the supervariable (node) graph.
     #[default]
     NestedDissection,
+    /// Nested dissection by coordinate planes ([`geometric`]); METIS's when the
+    /// solver was given no coordinates.
+    Geometric,
 }
 
 /// A permutation as faer reads it: `forward[k]` is the original index of the
@@ -64,6 +70,84 @@ pub fn supervariables(pattern: SymbolicSparseColMatRef<'_, usize>) -> Vec<usize>
     start
 }
 
+/// The supervariable graph of a pattern: a vertex per supervariable, `s` and `t`
+/// adjacent when a column of `s` has a row in `t` (no self loops). The neighbours
+/// of `s` are `adjncy[xadj[s]..xadj[s + 1]]`, sorted.
+pub struct SupervariableGraph {
+    /// `start[s]..start[s + 1]`: the columns of supervariable `s` ([`supervariables`]).
+    pub start: Vec<usize>,
+    pub xadj: Vec<usize>,
+    pub adjncy: Vec<u32>,
+}
+
+impl SupervariableGraph {
+    /// The graph of a structurally symmetric pattern (square CSC, both triangles).
+    pub fn of(pattern: SymbolicSparseColMatRef<'_, usize>) -> Result<Self, LinearSolverError> {
+        let n = pattern.ncols();
+        let (cp, ri) = (pattern.col_ptr(), pattern.row_idx());
+        let start = supervariables(pattern);
+        let n_super = start.len() - 1;
+        if u32::try_from(n_super).is_err() {
+            return Err(LinearSolverError::Faer(format!("ordering: {n_super} supervariables exceed a 32-bit index")));
+        }
+        let mut owner = vec![0u32; n];
+        for s in 0..n_super {
+            owner[start[s]..start[s + 1]].fill(s as u32);
+        }
+        // neighbours of s: the supervariables of the rows of its first column, without
+        // s itself; rows are sorted and a supervariable's columns consecutive, so
+        // duplicates are adjacent
+        let mut xadj = Vec::with_capacity(n_super + 1);
+        let mut adjncy = Vec::with_capacity(ri.len() / 9 + n_super);
+        xadj.push(0);
+        for s in 0..n_super {
+            let j = start[s];
+            let mut last = u32::MAX;
+            for &i in &ri[cp[j]..cp[j + 1]] {
+                let t = owner[i];
+                if t as usize != s && t != last {
+                    adjncy.push(t);
+                    last = t;
+                }
+            }
+            xadj.push(adjncy.len());
+        }
+        Ok(Self { start, xadj, adjncy })
+    }
+
+    pub fn n_vertices(&self) -> usize {
+        self.start.len() - 1
+    }
+
+    pub fn neighbours(&self, s: usize) -> &[u32] {
+        &self.adjncy[self.xadj[s]..self.xadj[s + 1]]
+    }
+
+    /// The column permutation of a supervariable order (`order[k]` the `k`-th
+    /// supervariable to eliminate): each supervariable's columns in turn.
+    pub fn expand(&self, order: impl IntoIterator<Item = usize>, what: &str) -> Result<Permutation, LinearSolverError> {
+        let n = *self.start.last().unwrap_or(&0);
+        let n_super = self.n_vertices();
+        let mut forward = Vec::with_capacity(n);
+        for s in order {
+            if s >= n_super {
+                return Err(LinearSolverError::Faer(format!("{what} returned an index out of range")));
+            }
+            forward.extend(self.start[s]..self.start[s + 1]);
+        }
+        let mut inverse = vec![usize::MAX; n];
+        for (k, &j) in forward.iter().enumerate() {
+            if j < n {
+                inverse[j] = k;
+            }
+        }
+        if forward.len() != n || inverse.contains(&usize::MAX) {
+            return Err(LinearSolverError::Faer(format!("{what} returned no permutation")));
+        }
+        Ok(Permutation { forward, inverse })
+    }
+}
+
 /// Nested-dissection ordering (METIS) of a structurally symmetric pattern
 /// (square CSC, both triangles stored).
 pub fn nested_dissection(pattern: SymbolicSparseColMatRef<'_, usize>) -> Result<Permutation, LinearSolverError> {
@@ -71,32 +155,12 @@ pub fn nested_dissection(pattern: SymbolicSparseColMatRef<'_, usize>) -> Result<
     if n == 0 {
         return Ok(Permutation { forward: vec![], inverse: vec![] });
     }
-    let (cp, ri) = (pattern.col_ptr(), pattern.row_idx());
-    let start = supervariables(pattern);
-    let n_super = start.len() - 1;
-    let mut owner = vec![0usize; n];
-    for s in 0..n_super {
-        owner[start[s]..start[s + 1]].fill(s);
-    }
+    let graph = SupervariableGraph::of(pattern)?;
+    let start = &graph.start;
+    let n_super = graph.n_vertices();
     let too_big = |what: &'static str| LinearSolverError::Faer(format!("METIS ordering: the {what} exceeds METIS's 32-bit index"));
-    // Supervariable graph in CSR (METIS): neighbours of s are the supervariables of
-    // the rows of its first column, without s itself. Rows are sorted and the dofs
-    // of a supervariable consecutive, so duplicates are adjacent.
-    let mut xadj: Vec<metis_sys::idx_t> = Vec::with_capacity(n_super + 1);
-    let mut adjncy: Vec<metis_sys::idx_t> = Vec::with_capacity(ri.len() / 9 + n_super);
-    xadj.push(0);
-    for s in 0..n_super {
-        let j = start[s];
-        let mut last = usize::MAX;
-        for &i in &ri[cp[j]..cp[j + 1]] {
-            let t = owner[i];
-            if t != s && t != last {
-                adjncy.push(metis_sys::idx_t::try_from(t).map_err(|_| too_big("node count"))?);
-                last = t;
-            }
-        }
-        xadj.push(metis_sys::idx_t::try_from(adjncy.len()).map_err(|_| too_big("graph's edge count"))?);
-    }
+    let mut xadj: Vec<metis_sys::idx_t> = graph.xadj.iter().map(|&k| metis_sys::idx_t::try_from(k)).collect::<Result<_, _>>().map_err(|_| too_big("graph's edge count"))?;
+    let mut adjncy: Vec<metis_sys::idx_t> = graph.adjncy.iter().map(|&t| metis_sys::idx_t::try_from(t)).collect::<Result<_, _>>().map_err(|_| too_big("node count"))?;
     let mut vwgt: Vec<metis_sys::idx_t> =
         (0..n_super).map(|s| metis_sys::idx_t::try_from(start[s + 1] - start[s]).unwrap_or(metis_sys::idx_t::MAX)).collect();
     let mut nvtxs = metis_sys::idx_t::try_from(n_super).map_err(|_| too_big("node count"))?;
@@ -121,23 +185,9 @@ pub fn nested_dissection(pattern: SymbolicSparseColMatRef<'_, usize>) -> Result<
     if status != metis_sys::rstatus_et_METIS_OK {
         return Err(LinearSolverError::Faer(format!("METIS_NodeND failed with status {status}")));
     }
-    // Expand: the supervariables in METIS's order, each with its columns in order.
-    let mut forward = Vec::with_capacity(n);
-    for &s in &perm {
-        let s = usize::try_from(s).map_err(|_| LinearSolverError::Faer("METIS_NodeND returned a negative index".into()))?;
-        if s >= n_super {
-            return Err(LinearSolverError::Faer("METIS_NodeND returned an index out of range".into()));
-        }
-        forward.extend(start[s]..start[s + 1]);
-    }
-    let mut inverse = vec![usize::MAX; n];
-    for (k, &j) in forward.iter().enumerate() {
-        inverse[j] = k;
-    }
-    if forward.len() != n || inverse.contains(&usize::MAX) {
-        return Err(LinearSolverError::Faer("METIS_NodeND returned no permutation".into()));
-    }
-    Ok(Permutation { forward, inverse })
+    // the supervariables in METIS's order, each with its columns in order
+    let order = perm.iter().map(|&s| usize::try_from(s).unwrap_or(usize::MAX));
+    graph.expand(order, "METIS_NodeND")
 }
 
 #[cfg(test)]
