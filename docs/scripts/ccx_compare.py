@@ -9,7 +9,8 @@ For each refinement level of a model:
      elements, materials, supports, loads, contact pair, friction, load path);
   4. run `sc-solve` and `ccx`, each as a whole process given the same threads
      (RAYON_NUM_THREADS for ours; OMP_NUM_THREADS and CCX_NPROC_EQUATION_SOLVER for
-     ccx), and read each one's wall time and peak RSS (wait4's ru_maxrss);
+     ccx), and read each one's wall time and peak RSS (GNU time's %M: wait4 on a
+     child of this script would start at the script's own peak);
   5. export our result and compare: the largest |u|, the support reaction, the
      total contact normal force and the peak contact pressure, and the Newton
      iterations of both.
@@ -84,14 +85,12 @@ MODELS = {
 
 
 def run_measured(cmd, cwd, env, log_path):
-    """Run cmd; (returncode, wall seconds, peak RSS in MB) of that process alone."""
-    t0 = time.perf_counter()
+    """Run cmd; (returncode, wall seconds, peak RSS in MB) of that process alone
+    (deck.run_with_peak: by GNU time, since wait4 on a child of this script starts
+    at the script's own peak)."""
     with open(log_path, "w") as log:
-        p = subprocess.Popen(cmd, cwd=cwd, env=env, stdout=log, stderr=subprocess.STDOUT)
-        _, status, usage = os.wait4(p.pid, 0)
-    wall = time.perf_counter() - t0
-    p.returncode = os.waitstatus_to_exitcode(status)
-    return p.returncode, wall, usage.ru_maxrss / 1024.0
+        rc, wall, peak_mb, _ = deck.run_with_peak(cmd, cwd, env, log)
+    return rc, wall, peak_mb
 
 
 def gmsh_exe():
