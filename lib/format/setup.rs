@@ -332,12 +332,12 @@ impl Default for PetscSetup {
 #[serde(rename_all = "snake_case")]
 pub enum OrderingChoice {
     /// METIS nested dissection on the node graph.
-    #[default]
     NestedDissection,
     /// faer's approximate minimum degree.
     Amd,
-    /// Nested dissection by coordinate planes through the mesh (the node graph
-    /// cut at the median node along the longest side of each part).
+    /// Nested dissection by coordinate planes through the mesh
+    /// (`solver::ordering::geometric`): the default.
+    #[default]
     Geometric,
 }
 
@@ -384,7 +384,7 @@ impl Default for LinearSolverSetup {
     fn default() -> Self {
         Self {
             method: LinearSolverChoice::Auto,
-            ordering: OrderingChoice::NestedDissection,
+            ordering: OrderingChoice::Geometric,
             factor_precision: PrecisionChoice::default(),
             gmres_tolerance: 1e-12,
             gmres_max_iterations: 100,
