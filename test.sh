@@ -5,7 +5,8 @@
 #   vtk is VTK's own reader for tests/py/check_vtk.py), put first on PATH (tests call
 #   `gmsh` and python's meshio);
 # - when we are root: CalculiX (Debian's calculix-ccx, for the side-by-side test of
-#   docs/scripts/ccx_compare.py), headless ParaView (paraview, python3-paraview, xvfb,
+#   docs/scripts/ccx_compare.py, and GNU time, through which it reads each program's
+#   peak RSS), headless ParaView (paraview, python3-paraview, xvfb,
 #   for tests/cli/paraview.rs), PETSc and Open MPI (libpetsc-real-dev, openmpi-bin,
 #   for the petsc feature). Without root, a missing CalculiX is an error; a missing
 #   ParaView or PETSc skips their tests, and says so loudly (CI runs as root, so there
@@ -30,6 +31,10 @@ apt_lines=()
 if ! command -v ccx >/dev/null 2>&1; then
     as_root || { echo "test.sh: ccx (CalculiX) is missing: install Debian's calculix-ccx (sudo apt-get install calculix-ccx)" >&2; exit 1; }
     apt_lines+=("calculix-ccx")
+fi
+if [ ! -x /usr/bin/time ] && as_root; then
+    # GNU time: ccx_compare.py reads each program's own peak RSS through it
+    apt_lines+=("time")
 fi
 if ! have_paraview; then
     if as_root; then
