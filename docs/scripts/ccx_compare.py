@@ -214,7 +214,7 @@ def run_level(model, spec, n, a, out_root):
     m = re.search(r"(\d+) free dofs", log)
     row["dofs"] = int(m.group(1)) if m else None
     m = re.search(r"linear solver (\S+): .*", log)
-    row["ours"] = dict(ok=rc == 0, wall_s=round(wall, 2), peak_rss_mb=round(rss, 1), linear=m.group(0) if m else None)
+    row["ours"] = dict(ok=rc == 0, wall_s=round(wall, 4), peak_rss_mb=round(rss, 1), linear=m.group(0) if m else None)
     row["ours"].update(phase_seconds(level_dir / (name + ".convergence.csv")))
     m = re.search(r"(\d+) Krylov iterations \(([\d.]+) per solve\)", log)
     if m:
@@ -274,7 +274,7 @@ def table(rows):
         f = lambda d, k, fmt="%.4g": (fmt % d[k]) if d.get(k) is not None else "–"
         rz = lambda d: ("%.5g" % d["reaction"][2]) if d.get("reaction") else "–"
         out.append("| %d | %s | %s | %s | %s | %s | %s | %s / %s | %s / %s | %s / %s | %s / %s |" % (
-            r["level"], f"{r['dofs']:,}" if r.get("dofs") else "–", f(c, "wall_s", "%.2f"), f(o, "wall_s", "%.2f"),
+            r["level"], f"{r['dofs']:,}" if r.get("dofs") else "–", f(c, "wall_s", "%.3g"), f(o, "wall_s", "%.3g"),
             ("%.1f×" % r["speedup"]) if r.get("speedup") else "–", f(c, "peak_rss_mb", "%.0f"), f(o, "peak_rss_mb", "%.0f"),
             f(c, "newton_iterations", "%d"), f(o, "newton_iterations", "%d"), f(c, "max_u", "%.6g"), f(o, "max_u", "%.6g"),
             rz(c), rz(o), f(c, "peak_pressure", "%.4g"), f(o, "peak_pressure", "%.4g")))

@@ -842,7 +842,7 @@ def run_ccx(deck, model, out, ccx):
     (out / (name + ".log")).write_text(log)
     blocks = parse_dat(job["dat"])
     res = dict(pipeline=None, deck=shown(out / (name + ".inp")), ccx_version=job["version"],
-               ok=ok, wall_seconds=round(job["wall"], 3), peak_rss_mb=round(job["peak_rss_mb"], 1), notes=model["notes"])
+               ok=ok, wall_seconds=round(job["wall"], 4), peak_rss_mb=round(job["peak_rss_mb"], 1), notes=model["notes"])
     if not ok:
         err = [l for l in log.splitlines() if "ERROR" in l or "error" in l]
         res["error"] = err[-5:] or log.splitlines()[-5:]
