@@ -594,6 +594,7 @@ impl LinearSolver for SymmetricPartGmres {
             n_krylov: self.n_krylov,
             n_fallback: self.n_fallback,
             n_reused: self.n_reused,
+            largest_factor: self.symmetric.timings().largest_factor.max(self.lu.timings().largest_factor),
         }
     }
 

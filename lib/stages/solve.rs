@@ -219,12 +219,13 @@ pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, 
     }
     let t = newton.linear_timings();
     log.line(&format!(
-        "linear solver {}: {} analyses {:.2} s, {} factorizations {:.2} s, {} solves {:.2} s{}",
+        "linear solver {}: {} analyses {:.2} s, {} factorizations {:.2} s{}, {} solves {:.2} s{}",
         newton.linear_solver_name(),
         t.n_symbolic,
         t.symbolic.as_secs_f64(),
         t.n_numeric,
         t.numeric.as_secs_f64(),
+        if t.largest_factor > 0 { format!(" (the largest factor {:.3} M entries)", t.largest_factor as f64 / 1e6) } else { String::new() },
         t.n_solve,
         t.solve.as_secs_f64(),
         if t.n_krylov > 0 || t.n_fallback > 0 {

@@ -182,6 +182,8 @@ pub struct FaerDirect {
     pending: Option<std::thread::JoinHandle<Result<Analysis, LinearSolverError>>>,
     /// Each unknown's node position, for [`FillOrdering::Geometric`].
     coordinates: Option<Arc<[[f64; 3]]>>,
+    /// Entries of the largest Cholesky-type factor analysed so far.
+    largest_factor: usize,
     symbolic_time: Duration,
     numeric_time: Duration,
     n_symbolic: usize,
@@ -211,6 +213,7 @@ impl FaerDirect {
             lower_nnz: 0,
             pending: None,
             coordinates: None,
+            largest_factor: 0,
             symbolic_time: Duration::ZERO,
             numeric_time: Duration::ZERO,
             n_symbolic: 0,
@@ -563,6 +566,7 @@ impl LinearSolver for FaerDirect {
             n_krylov: 0,
             n_fallback: 0,
             n_reused: 0,
+            largest_factor: self.largest_factor,
         }
     }
 }
@@ -673,6 +677,7 @@ impl FaerDirect {
         self.pattern = Some(a.pattern);
         self.diag_pos = a.diag_pos;
         self.symbolic = Some(a.symbolic);
+        self.largest_factor = self.largest_factor.max(self.factor_len());
         self.tree = a.tree;
         self.lower_nnz = a.lower_nnz;
         self.widest_supernode = a.widest_supernode;

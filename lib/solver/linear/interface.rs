@@ -55,6 +55,9 @@ pub struct SolverTimings {
     pub n_fallback: usize,
     /// `factor` calls that kept an earlier preconditioner instead of factoring.
     pub n_reused: usize,
+    /// Entries of the largest Cholesky-type factor analysed (0: none, or a backend
+    /// without one): its memory, 4 or 8 bytes an entry.
+    pub largest_factor: usize,
 }
 
 /// What the last `solve_in_place` did, for the log.

@@ -29,6 +29,7 @@
 //! (docs/performance.md, "Geometric nested dissection").
 //! It is deterministic: the selection and every tie go by the vertex index.
 
+use super::vertex_cover::Crossing;
 use super::{Permutation, SupervariableGraph};
 use crate::solver::linear::error::LinearSolverError;
 use faer::sparse::SymbolicSparseColMatRef;
@@ -62,7 +63,7 @@ pub fn geometric_dissection(pattern: SymbolicSparseColMatRef<'_, usize>, coordin
     if x.iter().flatten().any(|c| !c.is_finite()) {
         return Err(LinearSolverError::Faer("geometric ordering: a node coordinate is not finite".into()));
     }
-    let mut d = Dissection { graph: &graph, x: &x, stamp: vec![0; n_super], next: 1, order: Vec::with_capacity(n_super), local: vec![0; n_super] };
+    let mut d = Dissection { graph: &graph, x: &x, stamp: vec![0; n_super], next: 1, order: Vec::with_capacity(n_super), local: vec![0; n_super], position: vec![0; n_super] };
     d.part((0..n_super as u32).collect());
     graph.expand(d.order.iter().map(|&s| s as usize), "the geometric ordering")
 }
@@ -77,6 +78,8 @@ struct Dissection<'a> {
     order: Vec<u32>,
     /// a leaf vertex's index within its leaf
     local: Vec<u8>,
+    /// a layer vertex's index within its layer
+    position: Vec<u32>,
 }
 
 impl Dissection<'_> {
@@ -106,25 +109,24 @@ impl Dissection<'_> {
             return;
         }
         // the cuts at a third, half and two thirds of the part along each axis (the
-        // longest side first): the one of the smallest ratio of its separator to
-        // the smaller side (a ratio cut)
-        let mut best: Option<([Vec<u32>; 3], f64)> = None;
+        // longest side first): the one of the smallest ratio of its smaller layer
+        // to its smaller side (a ratio cut); its separator then the smallest along it
+        let mut best: Option<(Vec<u32>, Vec<u32>, f64)> = None;
         for axis in self.axes_by_extent(&vertices) {
             for quantile in QUANTILES {
                 let Some((below, above)) = self.cut(&mut vertices, axis, quantile) else { continue };
-                let candidate = self.separate(below, above);
-                let ratio = candidate[2].len() as f64 / candidate[0].len().min(candidate[1].len()).max(1) as f64;
-                if best.as_ref().is_none_or(|b| ratio < b.1) {
-                    best = Some((candidate, ratio));
+                let ratio = self.smaller_layer(&below, &above) as f64 / below.len().min(above.len()).max(1) as f64;
+                if best.as_ref().is_none_or(|b| ratio < b.2) {
+                    best = Some((below, above, ratio));
                 }
             }
         }
-        let best = best.map(|b| b.0);
-        let Some([first, second, separator]) = best else {
+        let Some((below, above, _)) = best else {
             // all nodes at one point: no plane cuts them
             self.order.extend_from_slice(&vertices);
             return;
         };
+        let [first, second, separator] = self.separate(below, above);
         let sides = [first, second];
         for side in sides {
             if !side.is_empty() {
@@ -203,49 +205,75 @@ impl Dissection<'_> {
         Some((below, above))
     }
 
-    /// The vertex separator of a cut: the smaller of the two layers along it (the
-    /// vertices of one side with a neighbour on the other). [side, side, separator].
+    /// The size of the smaller of the two layers along a cut (the vertices of one
+    /// side with a neighbour on the other): either separates the sides.
+    fn smaller_layer(&mut self, below: &[u32], above: &[u32]) -> usize {
+        let below_id = self.mark(below);
+        let above_id = self.mark(above);
+        let layer = |side: &[u32], other: u32| side.iter().filter(|&&v| self.graph.neighbours(v as usize).iter().any(|&w| self.stamp[w as usize] == other)).count();
+        layer(below, above_id).min(layer(above, below_id))
+    }
+
+    /// The vertex separator of a cut: a minimum vertex cover of the edges across
+    /// it ([`Crossing::minimum_cover`]), then thinned (a separator node with no
+    /// neighbour on one side joins it). [side, side, separator], sides by index.
     fn separate(&mut self, below: Vec<u32>, above: Vec<u32>) -> [Vec<u32>; 3] {
         let below_id = self.mark(&below);
         let above_id = self.mark(&above);
-        let layer = |side: &[u32], other: u32| -> Vec<bool> {
-            side.iter().map(|&v| self.graph.neighbours(v as usize).iter().any(|&w| self.stamp[w as usize] == other)).collect()
-        };
-        let below_layer = layer(&below, above_id);
-        let above_layer = layer(&above, below_id);
-        let split = |side: Vec<u32>, in_layer: &[bool]| -> (Vec<u32>, Vec<u32>) {
-            let (mut rest, mut separator) = (Vec::with_capacity(side.len()), Vec::new());
-            for (v, &l) in side.into_iter().zip(in_layer) {
-                if l { separator.push(v) } else { rest.push(v) }
+        // the two layers, and each above-layer node's index among them
+        let has_neighbour = |v: u32, other: u32, stamp: &[u32]| self.graph.neighbours(v as usize).iter().any(|&w| stamp[w as usize] == other);
+        let layer_a: Vec<u32> = below.iter().copied().filter(|&v| has_neighbour(v, above_id, &self.stamp)).collect();
+        let layer_b: Vec<u32> = above.iter().copied().filter(|&v| has_neighbour(v, below_id, &self.stamp)).collect();
+        for (k, &v) in layer_b.iter().enumerate() {
+            self.position[v as usize] = k as u32;
+        }
+        let mut crossing = Crossing { n_b: layer_b.len(), start: Vec::with_capacity(layer_a.len() + 1), adjacent: Vec::new() };
+        crossing.start.push(0);
+        for &v in &layer_a {
+            for &w in self.graph.neighbours(v as usize) {
+                if self.stamp[w as usize] == above_id {
+                    crossing.adjacent.push(self.position[w as usize]);
+                }
             }
-            (rest, separator)
-        };
-        let below_layered = below_layer.iter().filter(|&&l| l).count() <= above_layer.iter().filter(|&&l| l).count();
-        let (rest, mut other, separator) = if below_layered {
-            let (rest, separator) = split(below, &below_layer);
-            (rest, above, separator)
-        } else {
-            let (rest, separator) = split(above, &above_layer);
-            (rest, below, separator)
-        };
-        // a layer node with no neighbour in the rest of its side (at a corner of the
-        // cut, or a slave node coupled only across it) needs no separating: it
-        // joins the other side (not when the layer is the whole side: the other
-        // side would then be the whole part again)
-        let rest_id = self.mark(&rest);
-        let (mut kept, mut moved) = (Vec::with_capacity(separator.len()), false);
-        for v in separator {
-            if rest.is_empty() || self.graph.neighbours(v as usize).iter().any(|&w| self.stamp[w as usize] == rest_id) {
-                kept.push(v);
-            } else {
-                other.push(v);
-                moved = true;
+            crossing.start.push(crossing.adjacent.len());
+        }
+        let (cover_a, cover_b) = crossing.minimum_cover();
+        let cover_id = self.next;
+        self.next += 1;
+        let mut separator: Vec<u32> = Vec::with_capacity(layer_a.len().min(layer_b.len()));
+        for (&v, _) in layer_a.iter().zip(&cover_a).filter(|(_, &c)| c).chain(layer_b.iter().zip(&cover_b).filter(|(_, &c)| c)) {
+            self.stamp[v as usize] = cover_id;
+            separator.push(v);
+        }
+        let mut first: Vec<u32> = below.into_iter().filter(|&v| self.stamp[v as usize] != cover_id).collect();
+        let mut second: Vec<u32> = above.into_iter().filter(|&v| self.stamp[v as usize] != cover_id).collect();
+        // a separator node with no neighbour on one side needs no separating: it
+        // joins the other (a slave node coupled across the cut only, a corner);
+        // not when a side is empty (the other would be the whole part again)
+        if !first.is_empty() && !second.is_empty() {
+            let mut kept = Vec::with_capacity(separator.len());
+            let mut moved = false;
+            for v in separator {
+                if !has_neighbour(v, below_id, &self.stamp) {
+                    self.stamp[v as usize] = above_id;
+                    second.push(v);
+                    moved = true;
+                } else if !has_neighbour(v, above_id, &self.stamp) {
+                    self.stamp[v as usize] = below_id;
+                    first.push(v);
+                    moved = true;
+                } else {
+                    kept.push(v);
+                }
+            }
+            separator = kept;
+            if moved {
+                first.sort_unstable();
+                second.sort_unstable();
             }
         }
-        if moved {
-            other.sort_unstable();
-        }
-        if below_layered { [rest, other, kept] } else { [other, rest, kept] }
+        separator.sort_unstable();
+        [first, second, separator]
     }
 
     /// Exact minimum degree on the graph of a leaf (at most [`LEAF`] vertices): the
@@ -318,18 +346,7 @@ mod tests {
         let (cube, coords) = cube_coordinates(9);
         let p = cube.pattern.symbolic();
         let perm = geometric_dissection(p, &coords).unwrap();
-        let n = p.ncols();
-        let mut seen = vec![false; n];
-        for &j in &perm.forward {
-            assert!(!seen[j]);
-            seen[j] = true;
-        }
-        for (k, &j) in perm.forward.iter().enumerate() {
-            assert_eq!(perm.inverse[j], k);
-        }
-        for c in perm.forward.chunks(3) {
-            assert_eq!((c[1], c[2]), (c[0] + 1, c[0] + 2));
-        }
+        crate::solver::ordering::assert_keeps_nodes_together(&perm, p.ncols());
         // deterministic
         assert_eq!(geometric_dissection(p, &coords).unwrap(), perm);
         // the wrong number of coordinates is an error, not a panic

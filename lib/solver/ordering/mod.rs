@@ -28,6 +28,7 @@ use super::linear::error::LinearSolverError;
 use faer::sparse::SymbolicSparseColMatRef;
 
 pub mod geometric;
+pub mod vertex_cover;
 pub use geometric::geometric_dissection;
 
 /// Serialises the calls into METIS (its random generator is a process global).
@@ -190,6 +191,24 @@ pub fn nested_dissection(pattern: SymbolicSparseColMatRef<'_, usize>) -> Result<
     graph.expand(order, "METIS_NodeND")
 }
 
+/// `perm` is a permutation of `0..n` (with its inverse), and the 3 dofs of each
+/// node are consecutive pivots (every node of the test meshes has 3 free dofs).
+#[cfg(test)]
+pub(super) fn assert_keeps_nodes_together(perm: &Permutation, n: usize) {
+    let mut seen = vec![false; n];
+    for &j in &perm.forward {
+        assert!(!seen[j]);
+        seen[j] = true;
+    }
+    assert_eq!(perm.forward.len(), n);
+    for (k, &j) in perm.forward.iter().enumerate() {
+        assert_eq!(perm.inverse[j], k);
+    }
+    for c in perm.forward.chunks(3) {
+        assert_eq!((c[1], c[2]), (c[0] + 1, c[0] + 2));
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -210,19 +229,7 @@ mod tests {
         let cube = elastic_cube_system(5).unwrap();
         let p = cube.pattern.symbolic();
         let perm = nested_dissection(p).unwrap();
-        let n = p.ncols();
-        let mut seen = vec![false; n];
-        for &j in &perm.forward {
-            assert!(!seen[j]);
-            seen[j] = true;
-        }
-        for (k, &j) in perm.forward.iter().enumerate() {
-            assert_eq!(perm.inverse[j], k);
-        }
-        // dofs 3m, 3m+1, 3m+2 of a node are consecutive pivots
-        for c in perm.forward.chunks(3) {
-            assert_eq!((c[1], c[2]), (c[0] + 1, c[0] + 2));
-        }
+        assert_keeps_nodes_together(&perm, p.ncols());
         // deterministic, also when called from several threads at once
         assert_eq!(nested_dissection(p).unwrap(), perm);
         std::thread::scope(|scope| {
