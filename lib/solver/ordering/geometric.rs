@@ -10,23 +10,26 @@
 //!    pieces a separator left) is ordered component by component, with no separator;
 //! 2. a connected part is cut by planes normal to each axis, through the node at a
 //!    third, half and two thirds of it along the axis: `L` below, `R` at or above;
-//! 3. the separator is the smaller of the two layers along the cut, the nodes of
-//!    `L` with a neighbour in `R` or those of `R` with a neighbour in `L` (every
-//!    edge across the cut has an end in either, so removing it splits the part),
-//!    thinned: a layer node with no neighbour in the rest of its own side joins
-//!    the other side (a slave node coupled across the cut only, a corner); on a
-//!    structured hex mesh the separator is one plane of nodes, which is optimal;
-//! 4. of the nine cuts, the one whose separator is smallest relative to its smaller
-//!    side is taken (a ratio cut); its two sides are ordered first (recursively),
-//!    the separator last;
+//! 3. of the nine cuts, the one whose smaller layer (the nodes of `L` with a
+//!    neighbour in `R`, or those of `R` with one in `L`: either separates them) is
+//!    smallest relative to its smaller side is taken (a ratio cut);
+//! 4. its separator is a minimum vertex cover of the edges across it
+//!    ([`super::vertex_cover`]: no larger than either layer, and smaller where the
+//!    cut runs jagged through unstructured elements), thinned: a separator node
+//!    with no neighbour on one side joins it (a slave node coupled across the cut
+//!    only, a corner); on a structured hex mesh it is one plane of nodes, which is
+//!    optimal. The two sides are ordered first (recursively), the separator last;
 //! 5. a part of at most [`LEAF`] nodes is ordered by exact minimum degree on its own
 //!    graph (METIS switches to its multiple minimum degree at 120 vertices; here smaller
 //!    leaves fill less, see [`LEAF`]).
 //!
 //! Each level costs nine linear passes over the part (a selection for the plane,
-//! the layers) and one for the components, so the ordering takes O(n log n) on the
-//! supervariable graph: 4–17 ms on the cube where METIS takes 15–57 ms
-//! (docs/performance.md, "Geometric nested dissection").
+//! the layers), one for the components and a matching on the cut's edges, so the
+//! ordering takes about O(n log n) on the supervariable graph: a third to a
+//! quarter of METIS's time (docs/performance.md, "Geometric nested dissection").
+//! Its factor is METIS's within 3 % on structured hex meshes and about 1.2 × on
+//! unstructured ones, where METIS's refinement of the cut itself finds thinner
+//! separators than a plane.
 //! It is deterministic: the selection and every tie go by the vertex index.
 
 use super::vertex_cover::Crossing;
@@ -45,8 +48,9 @@ pub const LEAF: usize = 32;
 /// The median alone suits one body; the two blocks of the Parisch example, joined
 /// by contact, are cut better off it. Their factor against METIS's at r = 4 / 6 / 8:
 /// 1.20 / 1.10 / 1.12 with the median cuts alone, 1.06 / 1.06 / 1.08 with these
-/// three, 1.02 / 1.005 / 1.006 with the layer thinned as well (step 3); on the cube
-/// the three are the median's within 1 %.
+/// three, 1.02 / 1.005 / 1.006 with the smaller layer thinned as the separator,
+/// 0.975 / 0.988 / 1.030 with the minimum vertex cover (step 4); on the cube the
+/// three cuts are the median's within 1 %.
 const QUANTILES: [f64; 3] = [0.5, 1.0 / 3.0, 2.0 / 3.0];
 
 /// Geometric nested-dissection ordering of a structurally symmetric pattern (square
