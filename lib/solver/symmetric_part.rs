@@ -462,9 +462,9 @@ impl LinearSolver for SymmetricPartGmres {
         self.analyse_with(pattern, symmetry, true)
     }
 
+    /// For the symmetric part's ordering (the LU fallback orders by COLAMD).
     fn set_unknown_coordinates(&mut self, coordinates: std::sync::Arc<[[f64; 3]]>) {
-        self.symmetric.set_unknown_coordinates(coordinates.clone());
-        self.lu.set_unknown_coordinates(coordinates);
+        self.symmetric.set_unknown_coordinates(coordinates);
     }
 
     fn finish_analysis(&mut self) -> Result<(), LinearSolverError> {

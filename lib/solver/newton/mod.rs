@@ -231,14 +231,17 @@ impl<'p> Newton<'p> {
                 _ => Box::new(FaerDirect::new(direct)),
             }
         };
+        // each unknown's node position, for the ordering by coordinate planes (the
+        // only reader: not made for METIS, AMD or PETSc)
+        if direct.ordering == FillOrdering::Geometric && !petsc {
+            let unknowns: std::sync::Arc<[[f64; 3]]> = problem.dofs.global_of_free().iter().map(|&g| {
+                let x = &problem.X[g as usize / DOFS_PER_NODE];
+                [x[0], x[1], x[2]]
+            }).collect();
+            linear.set_unknown_coordinates(unknowns);
+        }
         // the first analysis runs while the first tangent is assembled; the first
         // factorization waits for it (`solve_increment`)
-        // each unknown's node position, for an ordering by coordinate planes
-        let unknowns: std::sync::Arc<[[f64; 3]]> = problem.dofs.global_of_free().iter().map(|&g| {
-            let x = &problem.X[g as usize / DOFS_PER_NODE];
-            [x[0], x[1], x[2]]
-        }).collect();
-        linear.set_unknown_coordinates(unknowns);
         linear.analyse_in_background(pattern.symbolic(), symmetry)?;
         let n = DOFS_PER_NODE * problem.n_nodes();
         let n_free = pattern.n_free();
