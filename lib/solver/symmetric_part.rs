@@ -63,7 +63,7 @@ use faer::sparse::{SymbolicSparseColMat, SymbolicSparseColMatRef};
 use rayon::prelude::*;
 
 use super::gmres::{gmres, GmresSettings};
-use super::linear::{check_values, FactorInfo, FaerDirect, FaerDirectOptions, Factorization, LinearSolver, LinearSolverError, SolveReport, SolverTimings, Symmetry};
+use super::linear::{check_values, FactorInfo, FaerDirect, FaerDirectOptions, Factorization, LinearSolver, LinearSolverError, SharedPattern, SolveReport, SolverTimings, Symmetry};
 
 /// A kept factorization gets at most this many times `reuse_below` GMRES
 /// iterations before `S` is factored anew (a tangent that moved far from it).
@@ -409,8 +409,9 @@ pub fn transpose_positions(pattern: SymbolicSparseColMatRef<'_, usize>) -> Optio
 }
 
 impl SymmetricPartGmres {
-    /// `analyse`, the symmetric part's analysis in the background when `background`.
-    fn analyse_with(&mut self, pattern: SymbolicSparseColMatRef<'_, usize>, symmetry: Symmetry, background: bool) -> Result<(), LinearSolverError> {
+    /// `analyse`, the symmetric part's analysis in the background when the pattern
+    /// comes shared.
+    fn analyse_with(&mut self, pattern: SymbolicSparseColMatRef<'_, usize>, symmetry: Symmetry, background: Option<&SharedPattern>) -> Result<(), LinearSolverError> {
         let start = Instant::now();
         self.analysed = false;
         self.held = None;
@@ -430,8 +431,8 @@ impl SymmetricPartGmres {
         if self.general_pattern(pattern.row_idx().len()) {
             self.lu.analyse(pattern, Symmetry::General)?;
             self.lu_analysed = true;
-        } else if background {
-            self.symmetric.analyse_in_background(pattern, Symmetry::Symmetric)?;
+        } else if let Some(shared) = background {
+            self.symmetric.analyse_in_background(shared, Symmetry::Symmetric)?;
         } else {
             self.symmetric.analyse(pattern, Symmetry::Symmetric)?;
         }
@@ -452,14 +453,14 @@ impl LinearSolver for SymmetricPartGmres {
     }
 
     fn analyse(&mut self, pattern: SymbolicSparseColMatRef<'_, usize>, symmetry: Symmetry) -> Result<(), LinearSolverError> {
-        self.analyse_with(pattern, symmetry, false)
+        self.analyse_with(pattern, symmetry, None)
     }
 
     /// The symmetric part's analysis (when the pattern is structurally symmetric)
     /// runs in the background as [`FaerDirect`]'s does; the LU's, when the pattern is
     /// not, here.
-    fn analyse_in_background(&mut self, pattern: SymbolicSparseColMatRef<'_, usize>, symmetry: Symmetry) -> Result<(), LinearSolverError> {
-        self.analyse_with(pattern, symmetry, true)
+    fn analyse_in_background(&mut self, pattern: &SharedPattern, symmetry: Symmetry) -> Result<(), LinearSolverError> {
+        self.analyse_with((**pattern).as_ref(), symmetry, Some(pattern))
     }
 
     /// For the symmetric part's ordering (the LU fallback orders by COLAMD).

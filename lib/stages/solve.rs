@@ -73,7 +73,14 @@ pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, 
     let mut point = if adjusts { None } else { restart.map(|r| RestartPoint::read(r.file, r.increment, &mesh, &pairs)).transpose()? };
     let problem = Problem::with_contact(&mesh, &pairs, setup, setup_name)?;
     // the pre-solve check: a flipped master stops here; free rigid modes are warned about
-    let check = crate::check::run(&mesh, &problem, &input.display().to_string(), setup_name)?;
+    // the check and the solver's set-up (the sparsity pattern, the analysis started)
+    // side by side: they read the same problem and neither needs the other; a
+    // refused model drops the set-up unused
+    let (check, newton) = rayon::join(
+        || crate::check::run(&mesh, &problem, &input.display().to_string(), setup_name),
+        || Newton::new(&problem, setup.newton.clone(), setup.linear_solver.clone()),
+    );
+    let check = check?;
     if let Some(e) = check.errors().into_iter().next() {
         return Err(e.into());
     }
@@ -98,7 +105,7 @@ pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, 
             )));
         }
     }
-    let mut newton = Newton::new(&problem, setup.newton.clone(), setup.linear_solver.clone())?;
+    let mut newton = newton?;
     let (rank, ranks) = crate::solver::ranks::rank_and_size();
     let mut log = SolveLog::new(if rank > 0 { Verbosity::Silent } else { verbosity }, factors.len());
     if ranks > 1 {

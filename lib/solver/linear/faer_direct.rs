@@ -62,7 +62,7 @@ use faer::{Conj, MatMut, Par, Side};
 use super::error::LinearSolverError;
 use super::tree_cholesky::TreeCholesky;
 use crate::solver::ordering::{geometric_dissection, nested_dissection, FillOrdering};
-use super::interface::{check_values, FactorInfo, Factorization, LinearSolver, SolverTimings, Symmetry};
+use super::interface::{check_values, FactorInfo, Factorization, LinearSolver, SharedPattern, SolverTimings, Symmetry};
 
 /// Widest supernode (columns) from which [`FaerDirect`] runs faer in parallel when
 /// its parallelism is left to it.
@@ -158,7 +158,7 @@ enum Numeric {
 /// `LU` for general ones; symbolic factorization reused across `factor` calls.
 pub struct FaerDirect {
     options: FaerDirectOptions,
-    pattern: Option<SymbolicSparseColMat<usize>>,
+    pattern: Option<SharedPattern>,
     /// Position of each diagonal entry in the values array (`usize::MAX` if absent).
     diag_pos: Vec<usize>,
     symbolic: Option<Symbolic>,
@@ -176,10 +176,10 @@ pub struct FaerDirect {
     /// Entries of the pattern's lower triangle, diagonal included (set by
     /// `analyse`): the size of the permuted copy the tree factorization reads.
     lower_nnz: usize,
-    /// An analysis still running on its own thread
-    /// ([`LinearSolver::analyse_in_background`]); joined by `finish_analysis` or
-    /// the next `factor`.
-    pending: Option<std::thread::JoinHandle<Result<Analysis, LinearSolverError>>>,
+    /// An analysis still running beside the caller
+    /// ([`LinearSolver::analyse_in_background`]); waited for by `finish_analysis`
+    /// or the next `factor`.
+    pending: Option<PendingAnalysis>,
     /// Each unknown's node position, for [`FillOrdering::Geometric`].
     coordinates: Option<Arc<[[f64; 3]]>>,
     /// Entries of the largest Cholesky-type factor analysed so far.
@@ -282,7 +282,7 @@ impl FaerDirect {
         let (Some(pattern), Some(Symbolic::Cholesky(sym))) = (&self.pattern, &self.symbolic) else {
             return Err(LinearSolverError::Order("factor", "analyse"));
         };
-        let a = SparseColMatRef::new(pattern.as_ref(), values);
+        let a = SparseColMatRef::new((**pattern).as_ref(), values);
         let orig = |j: usize| sym.perm().map_or(j, |p| p.arrays().0[j]);
         // faer 0.24 reports failed pivots 1-based in the simplicial path
         // (`index: k + 1`) and 0-based in the supernodal one.
@@ -471,21 +471,42 @@ impl LinearSolver for FaerDirect {
 
     fn analyse(&mut self, pattern: SymbolicSparseColMatRef<'_, usize>, symmetry: Symmetry) -> Result<(), LinearSolverError> {
         let owned = self.take_pattern(pattern)?;
+        let owned = Arc::new(owned);
         let done = analysis(owned, symmetry, self.options, self.coordinates.as_deref())?;
         self.install(done);
         Ok(())
     }
 
-    /// The analysis on a thread of its own while the caller goes on (the first
-    /// tangent's assembly), when rayon has more than one thread (with one, the
-    /// caller asked for one core: `analyse`).
-    fn analyse_in_background(&mut self, pattern: SymbolicSparseColMatRef<'_, usize>, symmetry: Symmetry) -> Result<(), LinearSolverError> {
+    /// The analysis beside the caller while it goes on (the first tangent's
+    /// assembly, or the elements' after a pattern rebuild), when rayon has more
+    /// than one thread (with one, the caller asked for one core: here). The
+    /// pattern is shared, not copied.
+    fn analyse_in_background(&mut self, pattern: &SharedPattern, symmetry: Symmetry) -> Result<(), LinearSolverError> {
+        let owned = self.share_pattern(pattern)?;
+        // known at once (an `Arc`), before the analysis that installs it again
+        self.pattern = Some(Arc::clone(&owned));
         if rayon::current_num_threads() < 2 {
-            return self.analyse(pattern, symmetry);
+            let done = analysis(owned, symmetry, self.options, self.coordinates.as_deref())?;
+            self.install(done);
+            return Ok(());
         }
-        let owned = self.take_pattern(pattern)?;
         let options = self.options;
         let coordinates = self.coordinates.clone();
+        if rayon::current_thread_index().is_none() {
+            // a task of rayon's pool: while it runs, the caller's parallel work
+            // (the first assembly) goes to the other workers, and the cores hold as
+            // many threads as they have (a thread of its own made three on two).
+            // Not from inside the pool: a worker that blocked on the task could hold
+            // up the only one that would run it.
+            let (tx, rx) = std::sync::mpsc::sync_channel(1);
+            rayon::spawn(move || {
+                let done = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| analysis(owned, symmetry, options, coordinates.as_deref())))
+                    .unwrap_or_else(|_| Err(LinearSolverError::Faer("the analysis panicked".into())));
+                let _ = tx.send(done);
+            });
+            self.pending = Some(PendingAnalysis::Pool(rx));
+            return Ok(());
+        }
         let (tx, rx) = std::sync::mpsc::channel();
         let spawned = std::thread::Builder::new().name("sc-analysis".into()).spawn(move || {
             let pattern = rx.recv().map_err(|_| LinearSolverError::Faer("the analysis thread got no pattern".into()))?;
@@ -495,7 +516,7 @@ impl LinearSolver for FaerDirect {
             Ok(handle) => {
                 // the pattern goes to the thread only once it runs (a failed spawn keeps it here)
                 tx.send(owned).map_err(|_| LinearSolverError::Faer("the analysis thread ended before its pattern".into()))?;
-                self.pending = Some(handle);
+                self.pending = Some(PendingAnalysis::Thread(handle));
             }
             // no thread to be had: the analysis here
             Err(_) => self.install(analysis(owned, symmetry, options, self.coordinates.as_deref())?),
@@ -508,8 +529,8 @@ impl LinearSolver for FaerDirect {
     }
 
     fn finish_analysis(&mut self) -> Result<(), LinearSolverError> {
-        if let Some(handle) = self.pending.take() {
-            let done = handle.join().map_err(|_| LinearSolverError::Faer("the analysis thread panicked".into()))??;
+        if let Some(pending) = self.pending.take() {
+            let done = pending.wait()?;
             self.install(done);
         }
         Ok(())
@@ -517,7 +538,7 @@ impl LinearSolver for FaerDirect {
 
     fn factor(&mut self, values: &[f64]) -> Result<FactorInfo, LinearSolverError> {
         self.finish_analysis()?;
-        let pattern = check_values(self.pattern.as_ref(), values)?;
+        let pattern = check_values(self.pattern.as_deref(), values)?;
         let start = Instant::now();
         self.numeric = Numeric::None;
         let result = match &self.symbolic {
@@ -571,13 +592,29 @@ impl LinearSolver for FaerDirect {
     }
 }
 
+/// An analysis running beside its caller: a task of rayon's pool, or (from inside
+/// the pool) a thread of its own.
+enum PendingAnalysis {
+    Pool(std::sync::mpsc::Receiver<Result<Analysis, LinearSolverError>>),
+    Thread(std::thread::JoinHandle<Result<Analysis, LinearSolverError>>),
+}
+
+impl PendingAnalysis {
+    fn wait(self) -> Result<Analysis, LinearSolverError> {
+        match self {
+            Self::Pool(rx) => rx.recv().map_err(|_| LinearSolverError::Faer("the analysis task ended without a result".into()))?,
+            Self::Thread(handle) => handle.join().map_err(|_| LinearSolverError::Faer("the analysis thread panicked".into()))?,
+        }
+    }
+}
+
 impl FaerDirect {
     /// Drops the pattern, the analysis and the factor (their memory), as a new
     /// `analyse` would before building its own.
     pub fn release(&mut self) {
-        if let Some(handle) = self.pending.take() {
+        if let Some(pending) = self.pending.take() {
             // its result is of the pattern being replaced: dropped, its time counted
-            if let Ok(Ok(a)) = handle.join() {
+            if let Ok(a) = pending.wait() {
                 self.symbolic_time += a.time;
                 self.n_symbolic += 1;
             }
@@ -595,7 +632,7 @@ impl FaerDirect {
 
     /// The analysed pattern, if any.
     pub fn pattern(&self) -> Option<&SymbolicSparseColMat<usize>> {
-        self.pattern.as_ref()
+        self.pattern.as_deref()
     }
 
     /// [`LinearSolver::solve_in_place`] without exclusive access (the factor is only
@@ -652,7 +689,7 @@ impl FaerDirect {
 
 /// What `analyse` makes of a pattern: everything a numeric factorization reads.
 struct Analysis {
-    pattern: SymbolicSparseColMat<usize>,
+    pattern: SharedPattern,
     diag_pos: Vec<usize>,
     symbolic: Symbolic,
     tree: Option<TreeCholesky>,
@@ -673,6 +710,16 @@ impl FaerDirect {
         pattern.to_owned().map_err(|e| LinearSolverError::Faer(format!("{e:?}")))
     }
 
+    /// [`Self::take_pattern`] of a shared pattern: the same checks, no copy.
+    fn share_pattern(&mut self, pattern: &SharedPattern) -> Result<SharedPattern, LinearSolverError> {
+        let n = pattern.nrows();
+        if pattern.ncols() != n {
+            return Err(LinearSolverError::Dimension { what: "columns (square matrix)", expected: n, got: pattern.ncols() });
+        }
+        self.release();
+        Ok(Arc::clone(pattern))
+    }
+
     fn install(&mut self, a: Analysis) {
         self.pattern = Some(a.pattern);
         self.diag_pos = a.diag_pos;
@@ -688,7 +735,7 @@ impl FaerDirect {
 
 /// Ordering and symbolic factorization of `owned` (on any thread: it reads nothing
 /// but its arguments).
-fn analysis(owned: SymbolicSparseColMat<usize>, symmetry: Symmetry, options: FaerDirectOptions, coordinates: Option<&[[f64; 3]]>) -> Result<Analysis, LinearSolverError> {
+fn analysis(owned: SharedPattern, symmetry: Symmetry, options: FaerDirectOptions, coordinates: Option<&[[f64; 3]]>) -> Result<Analysis, LinearSolverError> {
     let start = Instant::now();
     let n = owned.nrows();
     let diag_pos = (0..n)
@@ -701,12 +748,12 @@ fn analysis(owned: SymbolicSparseColMat<usize>, symmetry: Symmetry, options: Fae
         Symmetry::Symmetric => {
             let perm = match options.ordering {
                 FillOrdering::Amd => None,
-                FillOrdering::NestedDissection => Some(nested_dissection(owned.as_ref())?),
+                FillOrdering::NestedDissection => Some(nested_dissection((*owned).as_ref())?),
                 // without the unknowns' positions (a caller that gave none) the
                 // graph's own nested dissection
                 FillOrdering::Geometric => Some(match coordinates {
-                    Some(x) => geometric_dissection(owned.as_ref(), x)?,
-                    None => nested_dissection(owned.as_ref())?,
+                    Some(x) => geometric_dissection((*owned).as_ref(), x)?,
+                    None => nested_dissection((*owned).as_ref())?,
                 }),
             };
             let ordering = match &perm {
@@ -718,13 +765,13 @@ fn analysis(owned: SymbolicSparseColMat<usize>, symmetry: Symmetry, options: Fae
             // slab (4.5k unknowns), where the supernodal one (each node's 3 dofs a dense
             // block at least) factors in half the time (docs/performance.md).
             let params = CholeskySymbolicParams { supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL, ..Default::default() };
-            let c = factorize_symbolic_cholesky(owned.as_ref(), Side::Lower, ordering, params).map_err(|e| LinearSolverError::Faer(format!("{e:?}")))?;
+            let c = factorize_symbolic_cholesky((*owned).as_ref(), Side::Lower, ordering, params).map_err(|e| LinearSolverError::Faer(format!("{e:?}")))?;
             // sized in double even for a single-precision factor: one that f32 cannot
             // hold is made in double
             crate::solver::memory::check_cholesky(c.len_val(), n, owned.compute_nnz()).map_err(LinearSolverError::TooLarge)?;
             Symbolic::Cholesky(c)
         }
-        Symmetry::General => Symbolic::Lu(factorize_symbolic_lu(owned.as_ref(), Default::default()).map_err(|e| LinearSolverError::Faer(format!("{e:?}")))?),
+        Symmetry::General => Symbolic::Lu(factorize_symbolic_lu((*owned).as_ref(), Default::default()).map_err(|e| LinearSolverError::Faer(format!("{e:?}")))?),
     };
     let tree = match &symbolic {
         Symbolic::Cholesky(c) if options.elimination_tree => match c.raw() {

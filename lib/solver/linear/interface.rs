@@ -69,6 +69,10 @@ pub struct SolveReport {
     pub fallback: Option<String>,
 }
 
+/// A sparsity pattern shared between the assembly, which owns it, and the solver
+/// that analysed it (no copy of its arrays).
+pub type SharedPattern = std::sync::Arc<faer::sparse::SymbolicSparseColMat<usize>>;
+
 /// The interface every linear-solver backend implements.
 pub trait LinearSolver: Send {
     /// Short name for logs, e.g. `"faer-direct"`.
@@ -77,12 +81,13 @@ pub trait LinearSolver: Send {
     /// ordering and symbolic factorization. Call again when the pattern or the
     /// symmetry changes; invalidates the previous factorization.
     fn analyse(&mut self, pattern: SymbolicSparseColMatRef<'_, usize>, symmetry: Symmetry) -> Result<(), LinearSolverError>;
-    /// `analyse`, possibly still running when it returns (on a thread of its own,
-    /// while the caller assembles the first tangent); its errors then come from
+    /// `analyse`, possibly still running when it returns (beside the caller, who
+    /// assembles the tangent meanwhile); its errors then come from
     /// [`Self::finish_analysis`], which `factor` calls first. A backend without
-    /// a background analysis does it here.
-    fn analyse_in_background(&mut self, pattern: SymbolicSparseColMatRef<'_, usize>, symmetry: Symmetry) -> Result<(), LinearSolverError> {
-        self.analyse(pattern, symmetry)
+    /// a background analysis does it here. The pattern is shared, not copied: a
+    /// backend that keeps it holds the `Arc`.
+    fn analyse_in_background(&mut self, pattern: &SharedPattern, symmetry: Symmetry) -> Result<(), LinearSolverError> {
+        self.analyse((**pattern).as_ref(), symmetry)
     }
     /// Waits for an analysis started by [`Self::analyse_in_background`]; its error,
     /// if it failed.

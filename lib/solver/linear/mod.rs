@@ -23,4 +23,4 @@ pub mod interface;
 
 pub use error::LinearSolverError;
 pub use faer_direct::{FactorPrecision, FaerDirect, FaerDirectOptions, SymmetricStrategy, PARALLEL_SUPERNODE, SINGLE_PIVOT_FLOOR};
-pub use interface::{check_values, FactorInfo, Factorization, LinearSolver, SolveReport, SolverTimings, Symmetry};
+pub use interface::{check_values, FactorInfo, Factorization, LinearSolver, SharedPattern, SolveReport, SolverTimings, Symmetry};

@@ -242,7 +242,7 @@ impl<'p> Newton<'p> {
         }
         // the first analysis runs while the first tangent is assembled; the first
         // factorization waits for it (`solve_increment`)
-        linear.analyse_in_background(pattern.symbolic(), symmetry)?;
+        linear.analyse_in_background(pattern.shared(), symmetry)?;
         let n = DOFS_PER_NODE * problem.n_nodes();
         let n_free = pattern.n_free();
         let stabilization = Stabilization::new(problem, &contact);

@@ -301,13 +301,21 @@ fn the_elimination_tree_factor_is_faers_own_bit_for_bit_with_sequential_kernels(
 fn the_background_analysis_is_the_analysis() {
     let cube = elastic_cube_system(8).unwrap();
     let p = cube.pattern.symbolic_owned();
+    // `threads`: inside a pool of that many (the analysis on a thread of its own);
+    // 0: from outside any pool (the analysis a task of the global pool)
     let factor = |background: bool, threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-        pool.install(|| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads.max(1)).build().unwrap();
+        let run = || {
             let mut s = FaerDirect::new(FaerDirectOptions { par: Some(Par::Seq), ..Default::default() });
             if background {
-                s.analyse_in_background(p.as_ref(), Symmetry::Symmetric).unwrap();
-                assert_eq!(s.pending.is_some(), threads > 1, "{threads} threads");
+                s.analyse_in_background(cube.pattern.shared(), Symmetry::Symmetric).unwrap();
+                assert_eq!(s.pending.is_some(), rayon::current_num_threads() > 1, "{threads} threads");
+                if threads == 0 {
+                    assert!(matches!(s.pending, Some(PendingAnalysis::Pool(_)) | None));
+                } else {
+                    assert!(matches!(s.pending, Some(PendingAnalysis::Thread(_)) | None));
+                }
+                assert!(std::sync::Arc::ptr_eq(s.pattern.as_ref().unwrap(), cube.pattern.shared()), "shared, not copied");
             } else {
                 s.analyse(p.as_ref(), Symmetry::Symmetric).unwrap();
             }
@@ -317,11 +325,17 @@ fn the_background_analysis_is_the_analysis() {
             s.solve_in_place(&mut x).unwrap();
             assert!(residual_of(p, cube.assembly.values(), &x, &cube.rhs) < 1e-12);
             s.l_values.into_iter().map(f64::to_bits).collect::<Vec<_>>()
-        })
+        };
+        if threads == 0 {
+            run()
+        } else {
+            pool.install(run)
+        }
     };
     let direct = factor(false, 2);
     assert_eq!(factor(true, 2), direct);
     assert_eq!(factor(true, 1), direct);
+    assert_eq!(factor(true, 0), direct);
 
     // replaced while running: the new pattern's analysis is the one kept
     let small = elastic_cube_system(3).unwrap();
@@ -329,7 +343,7 @@ fn the_background_analysis_is_the_analysis() {
     let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
     pool.install(|| {
         let mut s = FaerDirect::default();
-        s.analyse_in_background(p.as_ref(), Symmetry::Symmetric).unwrap();
+        s.analyse_in_background(cube.pattern.shared(), Symmetry::Symmetric).unwrap();
         s.analyse(q.as_ref(), Symmetry::Symmetric).unwrap();
         assert!(s.pending.is_none());
         assert_eq!(s.pattern().unwrap().nrows(), q.nrows());
