@@ -478,8 +478,7 @@ impl LinearSolver for FaerDirect {
     }
 
     /// The analysis beside the caller while it goes on (the first tangent's
-    /// assembly, or the elements' after a pattern rebuild), when rayon has more
-    /// than one thread (with one, the caller asked for one core: here). The
+    /// assembly), when rayon has more than one thread (with one, the caller asked for one core: here). The
     /// pattern is shared, not copied.
     fn analyse_in_background(&mut self, pattern: &SharedPattern, symmetry: Symmetry) -> Result<(), LinearSolverError> {
         let owned = self.share_pattern(pattern)?;

@@ -91,9 +91,9 @@ impl Newton<'_> {
             // failure leaves the empty one, which `fits` no pattern: rebuilt next time
             self.assembly = Assembly::empty();
             self.assembly = Assembly::new(&self.pattern).map_err(|e| fail(e.to_string()))?;
-            // the new pattern's analysis runs while the elements are assembled; the
-            // factorization waits for it
-            self.linear.analyse_in_background(self.pattern.shared(), self.symmetry).map_err(|error| IncrementFailure::Linear { iteration, error })?;
+            // analysed here: beside the elements' assembly it saved no time on the
+            // punch's 79 rebuilds and cost 8 % more peak memory (docs/performance.md)
+            self.linear.analyse(self.pattern.symbolic(), self.symmetry).map_err(|error| IncrementFailure::Linear { iteration, error })?;
             self.pattern_rebuilds += 1;
         }
         Ok(())
