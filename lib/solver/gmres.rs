@@ -5,7 +5,10 @@
 //! `A M⁻¹`, then `x = M⁻¹ y`. Right preconditioning makes the minimised norm the
 //! true residual's, so the stopping test `‖b − A x‖ ≤ tol ‖b‖` means what it says;
 //! at each restart, and before reporting convergence, the residual is recomputed
-//! from `x` (the recurrence drifts from it in floating point).
+//! from `x` (the recurrence drifts from it in floating point). A solve to the
+//! round-off floor (a tolerance at or below [`FLOOR_TOLERANCE`]) estimates the
+//! floor at its first iterate, so that its first cycle stops there; the
+//! convergence test uses the floor at the final `x`.
 //!
 //! Arnoldi by modified Gram–Schmidt, the Hessenberg least-squares problem by Givens
 //! rotations. The preconditioner is applied once per iteration: the preconditioned
@@ -47,6 +50,10 @@ fn norm(a: &[f64]) -> f64 {
     dot(a, a).sqrt()
 }
 
+/// A tolerance at or below which a solve is one to the round-off floor: its
+/// first cycle stops at the floor estimated at its first iterate.
+pub const FLOOR_TOLERANCE: f64 = 1e-14;
+
 /// Solves `A x = b`, starting from `x = 0`. `apply(v, out)`: `out = A v`;
 /// `precondition(v)`: `v ← M⁻¹ v` in place; `floor(x)`: the residual norm that
 /// round-off alone leaves at `x` (e.g. `c ε ‖|A| |x|‖`, what a backward-stable
@@ -76,15 +83,26 @@ pub fn gmres(
     let (mut cs, mut sn, mut g) = (vec![0.0; m], vec![0.0; m], vec![0.0; m + 1]);
     let mut w = vec![0.0; n];
     let mut iterations = 0;
+    // A solve to the round-off floor: the floor, known only at an iterate, is
+    // estimated at the first one (the preconditioned residual, β M⁻¹ v₀, the iterate
+    // of a near-exact preconditioner), so that the first cycle stops there instead
+    // of iterating on to the tolerance's ε ‖b‖; the true residual decides after
+    // it, against the floor at the final x.
+    let to_floor = settings.tolerance <= FLOOR_TOLERANCE;
     loop {
-        // r = b − A x
-        apply(x, &mut w);
-        for (wi, bi) in w.iter_mut().zip(b) {
-            *wi = bi - *wi;
+        // r = b − A x (x = 0 at the start: r = b, no product)
+        if iterations == 0 {
+            w.copy_from_slice(b);
+        } else {
+            apply(x, &mut w);
+            for (wi, bi) in w.iter_mut().zip(b) {
+                *wi = bi - *wi;
+            }
         }
         let beta = norm(&w);
         if iterations > 0 {
-            target = target.max(floor(x));
+            // the floor at this x, not the first iterate's estimate
+            target = (settings.tolerance * b_norm).max(floor(x));
         }
         if beta <= target || iterations >= settings.max_iterations || !beta.is_finite() {
             return Ok(GmresOutcome { converged: beta <= target, iterations, relative_residual: beta / b_norm });
@@ -106,6 +124,13 @@ pub fn gmres(
             let (head, _) = v.split_at_mut(k + 1);
             zs[k].copy_from_slice(&head[k]);
             precondition(&mut zs[k])?;
+            if to_floor && iterations == 0 {
+                // the first iterate in w, which the product below overwrites
+                for (wj, zj) in w.iter_mut().zip(&zs[0]) {
+                    *wj = g[0] * zj;
+                }
+                target = target.max(floor(&w));
+            }
             apply(&zs[k], &mut w);
             // modified Gram–Schmidt against v_0 … v_k
             for (i, vi) in head.iter().enumerate() {
@@ -222,6 +247,37 @@ mod tests {
         .unwrap();
         assert!(out.converged && out.iterations == 1, "{out:?}");
         assert!(x.iter().zip(&d).all(|(x, d)| (x * d - 1.0).abs() < 1e-14));
+    }
+
+    /// A solve to the round-off floor stops where the floor is, in its first cycle:
+    /// as many iterations as a solve to a tolerance equal to the floor (without
+    /// the early estimate it iterates on toward ε ‖b‖). An estimate at the first
+    /// iterate that is too high stops the first cycle early, but the answer is
+    /// checked against the floor at the final x and iterated on to it.
+    #[test]
+    fn a_solve_to_the_floor_stops_at_the_floor_and_only_there() {
+        let n = 120;
+        let a = matrix(n, 2.0);
+        let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin() + 0.5).collect();
+        let b_norm = norm(&b);
+        let run = |tolerance: f64, floor: &mut dyn FnMut(&[f64]) -> f64| {
+            let mut x = vec![0.0; n];
+            let settings = GmresSettings { tolerance, max_iterations: 500, restart: 200 };
+            gmres(&b, &mut x, settings, &mut |v, o| mul(&a, v, o), &mut |_| Ok(()), floor).unwrap()
+        };
+        let to_tolerance = run(1e-9, &mut |_| 0.0);
+        let to_floor = run(f64::EPSILON, &mut |_| 1e-9 * b_norm);
+        assert!(to_floor.converged && to_floor.relative_residual <= 1e-9, "{to_floor:?}");
+        assert_eq!(to_floor.iterations, to_tolerance.iterations, "{to_floor:?} against {to_tolerance:?}");
+        let to_epsilon = run(1.1 * FLOOR_TOLERANCE, &mut |_| 1e-9 * b_norm);
+        assert!(to_epsilon.iterations > to_floor.iterations, "above FLOOR_TOLERANCE the first cycle runs on: {to_epsilon:?}");
+        // the first estimate a thousand times too high: still solved to the floor
+        let mut calls = 0;
+        let misled = run(f64::EPSILON, &mut |_| {
+            calls += 1;
+            if calls == 1 { 1e-6 * b_norm } else { 1e-9 * b_norm }
+        });
+        assert!(misled.converged && misled.relative_residual <= 1e-9, "{misled:?}");
     }
 
     #[test]

@@ -71,7 +71,7 @@ pub const KEPT_BUDGET_FACTOR: usize = 4;
 
 /// GMRES iterations a fresh single-precision factor gets before the tangent is
 /// factored in double precision: a factor that needs more preconditions poorly
-/// (κ ε₃₂ above ~0.15; the Parisch blocks need 5 to the round-off floor), and
+/// (κ ε₃₂ above ~0.15; the Parisch blocks need 3–4 to the round-off floor), and
 /// the double factorization costs less than the iterations it saves.
 pub const SINGLE_BUDGET: usize = 20;
 
