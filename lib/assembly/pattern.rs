@@ -172,8 +172,8 @@ impl Pattern {
         // its neighbours, in increasing order (the free numbering is monotone in the
         // global dof). Counted per node first, so that the columns are filled in
         // parallel into arrays of their final size.
-        let free_of = |a: usize| (0..DOFS_PER_NODE).filter(|&c| !dofs.is_constrained(DOFS_PER_NODE * a + c)).count();
-        let rows_of_node: Vec<usize> = neighbours.par_iter().map(|nb| nb.iter().map(|&b| free_of(b as usize)).sum()).collect();
+        let n_free_of: Vec<u8> = (0..n_nodes).map(|a| (0..DOFS_PER_NODE).filter(|&c| !dofs.is_constrained(DOFS_PER_NODE * a + c)).count() as u8).collect();
+        let rows_of_node: Vec<usize> = neighbours.par_iter().map(|nb| nb.iter().map(|&b| usize::from(n_free_of[b as usize])).sum()).collect();
         let n_free = dofs.n_free();
         let mut col_ptr = Vec::with_capacity(n_free + 1);
         col_ptr.push(0usize);
@@ -182,7 +182,7 @@ impl Pattern {
         let mut nnz = 0usize;
         for (a, &rows) in rows_of_node.iter().enumerate() {
             node_start.push(nnz);
-            for _ in 0..free_of(a) {
+            for _ in 0..n_free_of[a] {
                 nnz += rows;
                 col_ptr.push(nnz);
             }
@@ -230,7 +230,6 @@ impl Pattern {
         // found by one merge of the element's sorted nodes with a's sorted
         // neighbours, whose free dofs are counted on the way (a binary search of the
         // rows per node pair took a third of the pattern's time).
-        let n_free_of: Vec<u8> = (0..n_nodes).map(|a| free_of(a) as u8).collect();
         let element_slots = |nodes: &[u32], out: &mut [u32], (sorted, offset): &mut (Vec<(u32, u32)>, Vec<u32>)| {
             let nd = DOFS_PER_NODE * nodes.len();
             sorted.clear();

@@ -76,7 +76,8 @@ pub fn gmres(
         return Ok(GmresOutcome { converged: true, iterations: 0, relative_residual: 0.0 });
     }
     let m = settings.restart.max(1);
-    let mut target = settings.tolerance * b_norm;
+    let tolerance = settings.tolerance * b_norm;
+    let mut target = tolerance;
     let mut v: Vec<Vec<f64>> = vec![vec![0.0; n]];
     let mut zs: Vec<Vec<f64>> = Vec::new();
     let mut h = vec![vec![0.0; m]; m + 1]; // h[i][k]
@@ -103,7 +104,6 @@ pub fn gmres(
         if iterations > 0 {
             // the floor at this x, not the first iterate's estimate; not needed
             // (a pass over A) when the tolerance is met
-            let tolerance = settings.tolerance * b_norm;
             target = if beta <= tolerance { tolerance } else { tolerance.max(floor(x)) };
         }
         if beta <= target || iterations >= settings.max_iterations || !beta.is_finite() {

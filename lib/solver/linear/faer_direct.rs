@@ -471,23 +471,18 @@ impl LinearSolver for FaerDirect {
 
     fn analyse(&mut self, pattern: SymbolicSparseColMatRef<'_, usize>, symmetry: Symmetry) -> Result<(), LinearSolverError> {
         let owned = self.take_pattern(pattern)?;
-        let owned = Arc::new(owned);
-        let done = analysis(owned, symmetry, self.options, self.coordinates.as_deref())?;
-        self.install(done);
-        Ok(())
+        self.analyse_here(owned, symmetry)
     }
 
     /// The analysis beside the caller while it goes on (the first tangent's
-    /// assembly), when rayon has more than one thread (with one, the caller asked for one core: here). The
-    /// pattern is shared, not copied.
+    /// assembly), when rayon has more than one thread (with one, the caller asked
+    /// for one core: here). The pattern is shared, not copied.
     fn analyse_in_background(&mut self, pattern: &SharedPattern, symmetry: Symmetry) -> Result<(), LinearSolverError> {
         let owned = self.share_pattern(pattern)?;
         // known at once (an `Arc`), before the analysis that installs it again
         self.pattern = Some(Arc::clone(&owned));
         if rayon::current_num_threads() < 2 {
-            let done = analysis(owned, symmetry, self.options, self.coordinates.as_deref())?;
-            self.install(done);
-            return Ok(());
+            return self.analyse_here(owned, symmetry);
         }
         let options = self.options;
         let coordinates = self.coordinates.clone();
@@ -506,19 +501,11 @@ impl LinearSolver for FaerDirect {
             self.pending = Some(PendingAnalysis::Pool(rx));
             return Ok(());
         }
-        let (tx, rx) = std::sync::mpsc::channel();
-        let spawned = std::thread::Builder::new().name("sc-analysis".into()).spawn(move || {
-            let pattern = rx.recv().map_err(|_| LinearSolverError::Faer("the analysis thread got no pattern".into()))?;
-            analysis(pattern, symmetry, options, coordinates.as_deref())
-        });
-        match spawned {
-            Ok(handle) => {
-                // the pattern goes to the thread only once it runs (a failed spawn keeps it here)
-                tx.send(owned).map_err(|_| LinearSolverError::Faer("the analysis thread ended before its pattern".into()))?;
-                self.pending = Some(PendingAnalysis::Thread(handle));
-            }
+        let for_thread = Arc::clone(&owned);
+        match std::thread::Builder::new().name("sc-analysis".into()).spawn(move || analysis(for_thread, symmetry, options, coordinates.as_deref())) {
+            Ok(handle) => self.pending = Some(PendingAnalysis::Thread(handle)),
             // no thread to be had: the analysis here
-            Err(_) => self.install(analysis(owned, symmetry, options, self.coordinates.as_deref())?),
+            Err(_) => self.analyse_here(owned, symmetry)?,
         }
         Ok(())
     }
@@ -700,23 +687,24 @@ struct Analysis {
 impl FaerDirect {
     /// The checked, owned copy of a pattern to analyse; the old pattern, analysis
     /// and factor are dropped first (peak memory).
-    fn take_pattern(&mut self, pattern: SymbolicSparseColMatRef<'_, usize>) -> Result<SymbolicSparseColMat<usize>, LinearSolverError> {
-        let n = pattern.nrows();
-        if pattern.ncols() != n {
-            return Err(LinearSolverError::Dimension { what: "columns (square matrix)", expected: n, got: pattern.ncols() });
-        }
+    fn take_pattern(&mut self, pattern: SymbolicSparseColMatRef<'_, usize>) -> Result<SharedPattern, LinearSolverError> {
+        square(pattern.nrows(), pattern.ncols())?;
         self.release();
-        pattern.to_owned().map_err(|e| LinearSolverError::Faer(format!("{e:?}")))
+        pattern.to_owned().map(Arc::new).map_err(|e| LinearSolverError::Faer(format!("{e:?}")))
     }
 
     /// [`Self::take_pattern`] of a shared pattern: the same checks, no copy.
     fn share_pattern(&mut self, pattern: &SharedPattern) -> Result<SharedPattern, LinearSolverError> {
-        let n = pattern.nrows();
-        if pattern.ncols() != n {
-            return Err(LinearSolverError::Dimension { what: "columns (square matrix)", expected: n, got: pattern.ncols() });
-        }
+        square(pattern.nrows(), pattern.ncols())?;
         self.release();
         Ok(Arc::clone(pattern))
+    }
+
+    /// The analysis of `owned` on the caller's thread, installed.
+    fn analyse_here(&mut self, owned: SharedPattern, symmetry: Symmetry) -> Result<(), LinearSolverError> {
+        let done = analysis(owned, symmetry, self.options, self.coordinates.as_deref())?;
+        self.install(done);
+        Ok(())
     }
 
     fn install(&mut self, a: Analysis) {
@@ -732,11 +720,20 @@ impl FaerDirect {
     }
 }
 
+/// A pattern to factor is square.
+fn square(n_rows: usize, n_cols: usize) -> Result<(), LinearSolverError> {
+    if n_cols != n_rows {
+        return Err(LinearSolverError::Dimension { what: "columns (square matrix)", expected: n_rows, got: n_cols });
+    }
+    Ok(())
+}
+
 /// Ordering and symbolic factorization of `owned` (on any thread: it reads nothing
 /// but its arguments).
 fn analysis(owned: SharedPattern, symmetry: Symmetry, options: FaerDirectOptions, coordinates: Option<&[[f64; 3]]>) -> Result<Analysis, LinearSolverError> {
     let start = Instant::now();
-    let n = owned.nrows();
+    let a = (*owned).as_ref();
+    let n = a.nrows();
     let diag_pos = (0..n)
         .map(|j| {
             let (lo, hi) = (owned.col_ptr()[j], owned.col_ptr()[j + 1]);
@@ -747,12 +744,12 @@ fn analysis(owned: SharedPattern, symmetry: Symmetry, options: FaerDirectOptions
         Symmetry::Symmetric => {
             let perm = match options.ordering {
                 FillOrdering::Amd => None,
-                FillOrdering::NestedDissection => Some(nested_dissection((*owned).as_ref())?),
+                FillOrdering::NestedDissection => Some(nested_dissection(a)?),
                 // without the unknowns' positions (a caller that gave none) the
                 // graph's own nested dissection
                 FillOrdering::Geometric => Some(match coordinates {
-                    Some(x) => geometric_dissection((*owned).as_ref(), x)?,
-                    None => nested_dissection((*owned).as_ref())?,
+                    Some(x) => geometric_dissection(a, x)?,
+                    None => nested_dissection(a)?,
                 }),
             };
             let ordering = match &perm {
@@ -764,13 +761,13 @@ fn analysis(owned: SharedPattern, symmetry: Symmetry, options: FaerDirectOptions
             // slab (4.5k unknowns), where the supernodal one (each node's 3 dofs a dense
             // block at least) factors in half the time (docs/performance.md).
             let params = CholeskySymbolicParams { supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL, ..Default::default() };
-            let c = factorize_symbolic_cholesky((*owned).as_ref(), Side::Lower, ordering, params).map_err(|e| LinearSolverError::Faer(format!("{e:?}")))?;
+            let c = factorize_symbolic_cholesky(a, Side::Lower, ordering, params).map_err(|e| LinearSolverError::Faer(format!("{e:?}")))?;
             // sized in double even for a single-precision factor: one that f32 cannot
             // hold is made in double
             crate::solver::memory::check_cholesky(c.len_val(), n, owned.compute_nnz()).map_err(LinearSolverError::TooLarge)?;
             Symbolic::Cholesky(c)
         }
-        Symmetry::General => Symbolic::Lu(factorize_symbolic_lu((*owned).as_ref(), Default::default()).map_err(|e| LinearSolverError::Faer(format!("{e:?}")))?),
+        Symmetry::General => Symbolic::Lu(factorize_symbolic_lu(a, Default::default()).map_err(|e| LinearSolverError::Faer(format!("{e:?}")))?),
     };
     let tree = match &symbolic {
         Symbolic::Cholesky(c) if options.elimination_tree => match c.raw() {
