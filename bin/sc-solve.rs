@@ -1,4 +1,9 @@
 //! sc-solve: finite-strain static solve of a hex8 mesh, with frictional contact.
+// large blocks on huge pages (lib/os/large_pages.rs; SC_HUGE_PAGES=0 turns it off)
+#[cfg(target_os = "linux")]
+#[global_allocator]
+static ALLOCATOR: splinecontact::os::large_pages::LargePages = splinecontact::os::large_pages::LargePages;
+
 use std::path::PathBuf;
 use std::process::ExitCode;
 

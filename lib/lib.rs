@@ -14,6 +14,7 @@
 //! | `mesh`   | the mesh: nodes, hex8, bodies, node and face sets, hex8 topology |
 //! | `spline` | the B-spline master patch and its bilinear-facet counterpart |
 //! | `folder_lock` | one pipeline at a time per output folder (a lock file naming its owner) |
+//! | `os`     | what is asked of the operating system directly: the binaries' allocator (large blocks on huge pages) |
 //! | `material`, `fem` | constitutive models; the hex8 element: shape functions, quadrature, kinematics, internal force and tangent |
 //! | `assembly` | dof numbering, the sparsity pattern built once, element scatter |
 //! | `contact` | contact pairs: settings, the control net, the node-to-surface and mortar elements, the pair during the solve |
@@ -44,6 +45,7 @@ pub mod folder_lock;
 pub mod format;
 pub mod material;
 pub mod mesh;
+pub mod os;
 pub mod pipeline;
 pub mod post;
 pub mod solver;

@@ -21,7 +21,7 @@ use std::path::{Path, PathBuf};
 
 /// The layers from the bottom up: a file may import its own layer and those below.
 const LAYERS: &[(&str, &[&str])] = &[
-    ("foundations", &["lib/mesh/", "lib/spline/", "lib/folder_lock.rs"]),
+    ("foundations", &["lib/mesh/", "lib/spline/", "lib/folder_lock.rs", "lib/os/"]),
     ("elements", &["lib/material/", "lib/fem/"]),
     ("assembly", &["lib/assembly/"]),
     ("contact", &["lib/contact/"]),

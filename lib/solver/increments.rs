@@ -21,7 +21,7 @@ use super::restart::factors_done;
 use crate::assembly::DOFS_PER_NODE;
 use crate::fem::element::hex8_min_jacobian;
 use crate::format::scres::{Increment, IncrementInfo, Reaction, Results, ResultsFile, RunStatus};
-use crate::format::stage::{write_atomic, StageError};
+use crate::format::stage::{write_atomic_unsynced, StageError};
 
 /// The solve stopped.
 #[derive(Debug, thiserror::Error)]
@@ -332,6 +332,10 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
                         face_pressure,
                         charts,
                     });
+                    if k + 1 == n_inc && lambda >= target {
+                        // the last increment and the run's status in one append (one fdatasync)
+                        results.status = RunStatus::Completed;
+                    }
                     write(&mut file, &mut csvs, results, out, log)?;
                     if !out.writer {
                         // nor does it keep the history's arrays (0.2 GB an increment at
@@ -406,7 +410,8 @@ fn write(file: &mut ResultsFile, written: &mut WrittenCsvs, results: &Results, o
     let rewrite = |path: Option<&Path>, text: &str, last: &mut Option<String>| -> Result<(), StageError> {
         if let Some(path) = path {
             if last.as_deref() != Some(text) {
-                write_atomic(path, text.as_bytes())?;
+                // derived from the results file (synced above): renamed into place unsynced
+                write_atomic_unsynced(path, text.as_bytes())?;
                 *last = Some(text.to_owned());
             }
         }
@@ -426,7 +431,7 @@ fn stop(p: &Problem, trial: &[f64], results: &mut Results, file: &mut ResultsFil
         return SolveError::Write(e);
     }
     if let Some(csv) = out.csv.filter(|_| out.writer) {
-        if let Err(e) = write_atomic(csv, log.csv().as_bytes()) {
+        if let Err(e) = write_atomic_unsynced(csv, log.csv().as_bytes()) {
             return SolveError::Write(e);
         }
     }

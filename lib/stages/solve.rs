@@ -65,6 +65,7 @@ pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, 
         return Err(StageRunError::Usage("sc-solve writes its results after every increment: give a file with -o, not -".into()));
     }
     let start = Instant::now();
+    crate::solver::linear::dense_kernels::warm_in_background();
     let (mut mesh, pairs) = read_model(input)?;
     // A restart file of another model is named before the setup is checked against
     // this one; with `adjust` the file holds the adjusted coordinates, so it is

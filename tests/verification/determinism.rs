@@ -1,8 +1,10 @@
 //! The same input gives the same bytes: the shipped frictional crossed beams
 //! (`pipelines/crossed_beams.yaml`: import, tag, an augmented-Lagrangian solve with
 //! Coulomb friction and GMRES, export) run three times — with 1 thread, with 2, and
-//! with 2 again — write byte-identical stage files, `.vtu`/`.pvd` series and CSVs
-//! under `SC_REPRODUCIBLE=1` (which records the wall-clock times as 0). Without it,
+//! with 2 again, the large blocks then from the system allocator instead of huge
+//! pages (`SC_HUGE_PAGES=0`, lib/os/large_pages.rs) — write byte-identical stage
+//! files, `.vtu`/`.pvd` series and CSVs under `SC_REPRODUCIBLE=1` (which records
+//! the wall-clock times as 0). Without it,
 //! the per-iteration `seconds_*` and the increments' `seconds_output` are the only
 //! difference.
 
@@ -15,10 +17,20 @@ use crate::common::*;
 /// Run the pipeline staged in `dir` with `threads` rayon threads; every file it
 /// wrote, by name.
 fn run_pipeline(dir: &Path, threads: &str, reproducible: bool) -> BTreeMap<String, Vec<u8>> {
+    run_pipeline_with(dir, threads, reproducible, true)
+}
+
+/// [`run_pipeline`], the large blocks on huge pages or not (`SC_HUGE_PAGES=0`).
+fn run_pipeline_with(dir: &Path, threads: &str, reproducible: bool, huge_pages: bool) -> BTreeMap<String, Vec<u8>> {
     let out = dir.join("pipelines/out");
     let _ = std::fs::remove_dir_all(&out);
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_sc-pipeline"));
     cmd.args(["pipelines/crossed_beams.yaml", "-q"]).current_dir(dir).env("RAYON_NUM_THREADS", threads);
+    if !huge_pages {
+        cmd.env("SC_HUGE_PAGES", "0");
+    } else {
+        cmd.env_remove("SC_HUGE_PAGES");
+    }
     if reproducible {
         cmd.env("SC_REPRODUCIBLE", "1");
     } else {
@@ -39,13 +51,13 @@ fn same_input_same_bytes_with_one_and_two_threads() {
     let dir = staged_pipeline("crossed_beams", &["crossed_beams.msh"]);
     let one = run_pipeline(dir.path(), "1", true);
     let two = run_pipeline(dir.path(), "2", true);
-    let again = run_pipeline(dir.path(), "2", true);
+    let again = run_pipeline_with(dir.path(), "2", true, false);
     for ext in [".scmesh", ".sccontact", ".scres", ".vtu", ".pvd", ".forces.csv", ".convergence.csv"] {
         assert!(one.keys().any(|k| k.ends_with(ext)), "no {ext} written");
     }
-    assert_eq!(differing(&two, &again), Vec::<String>::new(), "two runs with 2 threads differ");
+    assert_eq!(differing(&two, &again), Vec::<String>::new(), "two runs with 2 threads differ (the second without huge pages)");
     assert_eq!(differing(&one, &two), Vec::<String>::new(), "1 and 2 threads differ");
-    eprintln!("{} files, {} bytes, identical in three runs (1, 2, 2 threads)", one.len(), one.values().map(Vec::len).sum::<usize>());
+    eprintln!("{} files, {} bytes, identical in three runs (1, 2, 2 threads, the last without huge pages)", one.len(), one.values().map(Vec::len).sum::<usize>());
 }
 
 /// Without `SC_REPRODUCIBLE` only the wall-clock times differ: the YAML dumps of

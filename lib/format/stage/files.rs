@@ -25,6 +25,15 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), StageError> {
     write_atomic_with(path, |w| w.write_all(bytes))
 }
 
+/// [`write_atomic`] without the `fsync` before the rename, for a file derived from
+/// another that is synced (the solver's CSV histories, which the results file holds
+/// and a restart rewrites): a killed process still leaves the old file or the new
+/// one, whole; a power loss may leave the new one empty. Saves an `fdatasync`
+/// (0.3–0.8 ms on the reference machine) per rewrite.
+pub fn write_atomic_unsynced(path: &Path, bytes: &[u8]) -> Result<(), StageError> {
+    write_replacing(path, false, |w| w.write_all(bytes))
+}
+
 /// Where [`write_atomic_with`] puts its bytes, decided by what `path` names now.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum OutputKind {
@@ -77,6 +86,11 @@ pub fn output_kind(path: &Path) -> Result<OutputKind, StageError> {
 /// - `-`: standard output;
 /// - a directory: an error, before `f` runs.
 pub fn write_atomic_with(path: &Path, f: impl FnOnce(&mut dyn Write) -> io::Result<()>) -> Result<(), StageError> {
+    write_replacing(path, true, f)
+}
+
+/// [`write_atomic_with`], the temporary `fsync`ed before the rename when `sync`.
+fn write_replacing(path: &Path, sync: bool, f: impl FnOnce(&mut dyn Write) -> io::Result<()>) -> Result<(), StageError> {
     let shown = path.display().to_string();
     let io_err = |action: &'static str| {
         let shown = shown.clone();
@@ -104,7 +118,9 @@ pub fn write_atomic_with(path: &Path, f: impl FnOnce(&mut dyn Write) -> io::Resu
         let mut w = io::BufWriter::with_capacity(1 << 20, file);
         f(&mut w)?;
         let file = w.into_inner().map_err(|e| e.into_error())?;
-        file.sync_data()?;
+        if sync {
+            file.sync_data()?;
+        }
         Ok(())
     })();
     if let Err(e) = result {
@@ -159,5 +175,25 @@ pub fn resolve(base: &Path, p: &Path) -> PathBuf {
         p.to_path_buf()
     } else {
         base.join(p)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Synced or not, a write replaces the target whole and leaves no temporary;
+    /// a directory is refused before anything is written.
+    #[test]
+    fn an_unsynced_write_replaces_the_target_and_leaves_no_temporary() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("h.convergence.csv");
+        write_atomic(&target, b"old\n").unwrap();
+        write_atomic_unsynced(&target, b"iteration,residual\n0,1\n").unwrap();
+        assert_eq!(fs::read(&target).unwrap(), b"iteration,residual\n0,1\n");
+        let names: Vec<_> = fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+        assert_eq!(names, ["h.convergence.csv"]);
+        let err = write_atomic_unsynced(dir.path(), b"x").unwrap_err().to_string();
+        assert!(err.contains(&dir.path().display().to_string()), "{err}");
     }
 }

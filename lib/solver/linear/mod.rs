@@ -16,6 +16,7 @@
 //! | [`faer_direct`] | the faer backend: ordering and symbolic factorization once, `LLᵀ` → `LDLᵀ` or `LU` per Newton iteration, the singularity check |
 //! | [`tree_cholesky`] | the numeric supernodal `LLᵀ`, parallel over the elimination tree, into faer's factor layout |
 
+pub mod dense_kernels;
 pub mod error;
 pub mod faer_direct;
 pub mod tree_cholesky;
