@@ -237,6 +237,7 @@ impl Results {
 
     fn encode_segments(&self) -> (Vec<u8>, SegmentEnd) {
         let mut w = StageWriter::new(FORMAT, MAJOR, MINOR);
+        w.reserve(self.encoded_size_estimate(0));
         let meta = ResultsMeta {
             source: self.source.clone(),
             setup: self.setup.clone(),
@@ -255,6 +256,17 @@ impl Results {
         w.finish_segments()
     }
 
+    /// About the bytes of the mesh and of increments `first..` (their arrays, with
+    /// 64 KiB for the YAML records): what the writer reserves at once.
+    fn encoded_size_estimate(&self, first: usize) -> usize {
+        let (n, m) = (self.mesh.nodes.len(), self.mesh.hexes.len());
+        let mesh = if first == 0 { n * 24 + m * 40 } else { 0 };
+        let per_increment = |inc: &Increment| {
+            n * 24 + m * 8 * 9 * 8 + inc.contact.iter().map(|s| s.len() * 48).sum::<usize>() + inc.friction.iter().map(|f| f.len() * 72).sum::<usize>() + inc.face_pressure.iter().map(|f| f.len() * 8).sum::<usize>()
+        };
+        (1 << 16) + mesh + self.increments.iter().skip(first).map(per_increment).sum::<usize>()
+    }
+
     /// The segments of increments `first..` and, once the run ended, of its status.
     fn encode_tail(&self, w: &mut StageWriter, first: usize) {
         let (n, m) = (self.mesh.nodes.len() as u64, self.mesh.hexes.len() as u64);
@@ -263,8 +275,7 @@ impl Results {
             w.meta(&serde_yaml::to_string(&meta).expect("increment metadata serialises"));
             let u = inc.displacements();
             w.f64s(&format!("inc/{k}/u"), &[n, 3], &u);
-            let s: Vec<f64> = inc.stress.iter().flatten().flatten().copied().collect();
-            w.f64s(&format!("inc/{k}/stress"), &[m, 8, 9], &s);
+            w.f64s(&format!("inc/{k}/stress"), &[m, 8, 9], inc.stress.as_flattened().as_flattened());
             for (p, state) in inc.contact.iter().enumerate() {
                 let v: Vec<f64> = state.iter().flatten().copied().collect();
                 w.f64s(&format!("inc/{k}/pair/{p}/state"), &[state.len() as u64, 6], &v);
@@ -454,6 +465,7 @@ impl ResultsFile {
             }
             Some((file, end)) => {
                 let mut w = StageWriter::append_to(*end);
+                w.reserve(results.encoded_size_estimate(self.written));
                 results.encode_tail(&mut w, self.written);
                 let (bytes, new_end) = w.finish_segments();
                 self.appends += 1;

@@ -69,6 +69,12 @@ use super::linear::{check_values, FactorInfo, FaerDirect, FaerDirectOptions, Fac
 /// iterations before `S` is factored anew (a tangent that moved far from it).
 pub const KEPT_BUDGET_FACTOR: usize = 4;
 
+/// The loosest relative tolerance a kept factorization's solve of a symmetric
+/// tangent is given (`SymmetricPartGmres::kept_symmetric_settings`): its GMRES stops at
+/// `tolerance × ‖b₀‖`, `b₀` the largest right-hand side of the increment so far
+/// (its first, usually), and never above this relative to its own `‖b‖`.
+pub const KEPT_LOOSEST: f64 = 1e-8;
+
 /// GMRES iterations a fresh single-precision factor gets before the tangent is
 /// factored in double precision: a factor that needs more preconditions poorly
 /// (κ ε₃₂ above ~0.15; the Parisch blocks need 3–4 to the round-off floor), and
@@ -112,6 +118,8 @@ pub struct SymmetricPartGmres {
     fresh: bool,
     /// GMRES iterations of the last solve that converged (`usize::MAX`: none yet).
     last_iterations: usize,
+    /// The largest `‖b‖` solved for since the increment began (`begin_increment`).
+    increment_rhs: f64,
     n_reused: usize,
     last: SolveReport,
     symbolic_time: Duration,
@@ -139,6 +147,7 @@ impl SymmetricPartGmres {
             held: None,
             fresh: false,
             last_iterations: usize::MAX,
+            increment_rhs: 0.0,
             n_reused: 0,
             base_tolerance: settings.tolerance,
             settings,
@@ -214,6 +223,18 @@ impl SymmetricPartGmres {
     fn kept_settings(&self) -> GmresSettings {
         let budget = KEPT_BUDGET_FACTOR * self.reuse_below.max(1);
         GmresSettings { max_iterations: self.settings.max_iterations.min(budget), ..self.settings }
+    }
+
+    /// [`Self::kept_settings`] of a symmetric tangent's solve of `‖b‖ = b_norm`, to
+    /// the tolerance of the increment's scale ([`KEPT_LOOSEST`]).
+    fn kept_symmetric_settings(&self, b_norm: f64) -> GmresSettings {
+        // the increment's scale: each of its solves to `tolerance` of its first
+        // right-hand side, as accurate in u as the first (a direct solve's up to
+        // round-off), not to `tolerance` of its own, which near convergence is
+        // 1e-6 of the first and asks six more digits than u can hold
+        let scaled = if b_norm > 0.0 { self.settings.tolerance * self.increment_rhs / b_norm } else { self.settings.tolerance };
+        let tolerance = scaled.clamp(self.settings.tolerance, KEPT_LOOSEST.max(self.settings.tolerance));
+        GmresSettings { tolerance, ..self.kept_settings() }
     }
 
     /// Factor `S` of the stored values: `S[p] = (K[p] + Kᵀ[p]) / 2` (in double
@@ -305,12 +326,14 @@ impl SymmetricPartGmres {
         }
         self.rhs.clear();
         self.rhs.extend_from_slice(rhs);
+        let b_norm = rhs.iter().map(|v| v * v).sum::<f64>().sqrt();
+        self.increment_rhs = self.increment_rhs.max(b_norm);
         // a fresh single-precision factor stands for a direct solve: GMRES to the
         // round-off floor a direct solve reaches (the floor stops it), not only to
         // the tolerance, which would leave a problem solved in one Newton
         // iteration accurate to κ times 1e-12 (the mortar patch tests, with S in
         // single in a trial: exact to 1.9e-8 instead of 1e-11)
-        let settings = if self.fresh { self.fresh_single_settings() } else { self.kept_settings() };
+        let settings = if self.fresh { self.fresh_single_settings() } else { self.kept_symmetric_settings(b_norm) };
         let mut iterations = 0;
         let mut converged = self.gmres_converged(rhs, settings, &mut iterations);
         let mut result = Ok(());
@@ -516,6 +539,7 @@ impl LinearSolver for SymmetricPartGmres {
     fn begin_increment(&mut self) {
         // the held S is not used again: the increment's first `factor` factors anew
         self.held = None;
+        self.increment_rhs = 0.0;
     }
 
     fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolverError> {
@@ -797,6 +821,40 @@ mod tests {
         s.begin_increment();
         s.factor(&v).unwrap();
         assert!(s.fresh);
+    }
+
+    /// A kept factor's solve of a symmetric tangent stops at the tolerance times the
+    /// increment's first right-hand side: a right-hand side a hundredth of it to
+    /// 1e-10 of its own, in fewer iterations than one of the first's size; a
+    /// millionth never above [`KEPT_LOOSEST`] of its own; a new increment measures
+    /// from its own first.
+    #[test]
+    fn a_kept_factor_solves_to_the_scale_of_the_increment() {
+        let (p, v, b) = skewed(0.0);
+        let mut s = SymmetricPartGmres::with_reuse(GmresSettings::default(), FaerDirectOptions::default(), 8);
+        s.analyse(p.as_ref(), Symmetry::Symmetric).unwrap();
+        s.begin_increment();
+        s.factor(&v).unwrap();
+        let mut x = b.clone();
+        s.solve_in_place(&mut x).unwrap();
+        let v2 = scale_diagonal(&p, &v, |j| 1.0 + 0.005 * ((j % 7) as f64) / 7.0);
+        let kept_solve = |s: &mut SymmetricPartGmres, rhs: &[f64]| {
+            s.factor(&v2).unwrap();
+            assert!(!s.fresh, "the factor is kept");
+            let mut x = rhs.to_vec();
+            s.solve_in_place(&mut x).unwrap();
+            (residual(&p, &v2, &x, rhs), s.last_solve().krylov_iterations)
+        };
+        let (r_full, its_full) = kept_solve(&mut s, &b);
+        assert!(r_full <= 1e-12, "{r_full:e}");
+        let hundredth: Vec<f64> = b.iter().map(|v| 1e-2 * v).collect();
+        let (r, its) = kept_solve(&mut s, &hundredth);
+        assert!(r <= 1e-10 && its < its_full, "relative residual {r:e} in {its} iterations, {its_full} for the first's size");
+        let millionth: Vec<f64> = b.iter().map(|v| 1e-6 * v).collect();
+        let (r, _) = kept_solve(&mut s, &millionth);
+        assert!(r <= KEPT_LOOSEST, "{r:e}");
+        s.begin_increment();
+        assert_eq!(s.increment_rhs, 0.0);
     }
 
     #[test]

@@ -73,22 +73,39 @@ impl StageWriter {
     pub fn f64s(&mut self, name: &str, dims: &[u64], v: &[f64]) {
         debug_assert_eq!(dims.iter().product::<u64>() as usize, v.len());
         self.array_header(name, Dtype::F64, dims);
-        v.iter().for_each(|x| self.buf.extend_from_slice(&x.to_le_bytes()));
+        self.put(v, |x| x.to_le_bytes());
     }
     pub fn u32s(&mut self, name: &str, dims: &[u64], v: &[u32]) {
         debug_assert_eq!(dims.iter().product::<u64>() as usize, v.len());
         self.array_header(name, Dtype::U32, dims);
-        v.iter().for_each(|x| self.buf.extend_from_slice(&x.to_le_bytes()));
+        self.put(v, |x| x.to_le_bytes());
     }
     pub fn u64s(&mut self, name: &str, dims: &[u64], v: &[u64]) {
         debug_assert_eq!(dims.iter().product::<u64>() as usize, v.len());
         self.array_header(name, Dtype::U64, dims);
-        v.iter().for_each(|x| self.buf.extend_from_slice(&x.to_le_bytes()));
+        self.put(v, |x| x.to_le_bytes());
     }
     pub fn i32s(&mut self, name: &str, dims: &[u64], v: &[i32]) {
         debug_assert_eq!(dims.iter().product::<u64>() as usize, v.len());
         self.array_header(name, Dtype::I32, dims);
-        v.iter().for_each(|x| self.buf.extend_from_slice(&x.to_le_bytes()));
+        self.put(v, |x| x.to_le_bytes());
+    }
+
+    /// The little-endian bytes of `v`, appended in one resize and one pass of fixed
+    /// width copies (a push per value checks the capacity each time and does not
+    /// vectorise: 2 MB of Gauss stresses took about 1 ms that way).
+    fn put<T: Copy, const B: usize>(&mut self, v: &[T], le: impl Fn(T) -> [u8; B]) {
+        let start = self.buf.len();
+        self.buf.resize(start + B * v.len(), 0);
+        for (out, &x) in self.buf[start..].chunks_exact_mut(B).zip(v) {
+            out.copy_from_slice(&le(x));
+        }
+    }
+
+    /// Room for `bytes` more (a writer that knows the size of what follows allocates
+    /// once instead of doubling its buffer).
+    pub fn reserve(&mut self, bytes: usize) {
+        self.buf.reserve(bytes);
     }
     pub fn u8s(&mut self, name: &str, dims: &[u64], v: &[u8]) {
         debug_assert_eq!(dims.iter().product::<u64>() as usize, v.len());
