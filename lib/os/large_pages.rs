@@ -5,12 +5,10 @@
 //! touches almost every page it allocates once (the sparsity pattern, the slot
 //! maps, the tangent's values, the factor, the results' buffers): at 10k unknowns
 //! 14,600 faults, about 26 ms of CPU in a 140 ms run. Blocks of at least
-//! [`THRESHOLD`] bytes are therefore mapped on their own, in whole 2 MiB pages, and
+//! [`THRESHOLD`] bytes are therefore mapped on their own, from a 2 MiB boundary, and
 //! advised `MADV_HUGEPAGE` (honoured when the kernel's transparent huge pages are
 //! `madvise` or `always`); smaller ones go to the system allocator. Measured on the
-//! Parisch blocks (docs/performance.md): 4,560 faults instead of 14,600 at r = 6,
-//! whole runs 7 % quicker from r = 6 on, peak memory 5–7 MB higher (the last huge
-//! page of each block is resident whole).
+//! Parisch blocks and the crossed beams: docs/performance.md.
 //!
 //! `SC_HUGE_PAGES=0` in the environment turns it off (every block from the system
 //! allocator), for a kernel whose huge-page compaction stalls.
@@ -60,22 +58,41 @@ fn mapped(size: usize, align: usize) -> bool {
     size >= THRESHOLD && align < PAGE && enabled()
 }
 
-/// The mapping's length for a block of `size` bytes: whole huge pages.
+/// The mapping's length for a block of `size` bytes: whole 4 KiB pages (the
+/// block's whole huge pages on huge pages, its tail on small ones: rounding every
+/// block up to whole huge pages cost the frictional crossed beams n = 4 17 MB of
+/// peak, a quarter, for the last huge page of each 2–6 MB block).
 fn mapped_len(size: usize) -> usize {
-    size.div_ceil(HUGE) * HUGE
+    size.div_ceil(PAGE) * PAGE
 }
 
-/// A fresh anonymous mapping (zeroed) advised for huge pages, or null.
+/// A fresh anonymous mapping (zeroed) of `mapped_len(size)` bytes starting on a
+/// huge-page boundary, advised for huge pages, or null.
 unsafe fn map(size: usize) -> *mut u8 {
     let len = mapped_len(size);
-    // SAFETY: an anonymous private mapping of `len` bytes, owned by the caller
-    let p = unsafe { libc::mmap(std::ptr::null_mut(), len, libc::PROT_READ | libc::PROT_WRITE, libc::MAP_PRIVATE | libc::MAP_ANONYMOUS, -1, 0) };
+    // one huge page more, then the parts before the boundary and after the block
+    // given back: the block starts where a huge page can
+    let over = len + HUGE;
+    // SAFETY: an anonymous private mapping of `over` bytes, trimmed below to the
+    // `len` bytes owned by the caller
+    let p = unsafe { libc::mmap(std::ptr::null_mut(), over, libc::PROT_READ | libc::PROT_WRITE, libc::MAP_PRIVATE | libc::MAP_ANONYMOUS, -1, 0) };
     if p == libc::MAP_FAILED {
         return std::ptr::null_mut();
     }
-    // advice only: a kernel without huge pages keeps 4 KiB ones
-    unsafe { libc::madvise(p, len, libc::MADV_HUGEPAGE) };
-    p.cast()
+    let start = p as usize;
+    let aligned = start.next_multiple_of(HUGE);
+    unsafe {
+        if aligned > start {
+            libc::munmap(p, aligned - start);
+        }
+        let end = aligned + len;
+        if start + over > end {
+            libc::munmap(end as *mut libc::c_void, start + over - end);
+        }
+        // advice only: a kernel without huge pages keeps 4 KiB ones
+        libc::madvise(aligned as *mut libc::c_void, len, libc::MADV_HUGEPAGE);
+    }
+    aligned as *mut u8
 }
 
 // SAFETY: blocks below the threshold are System's; those from it on are whole
@@ -196,9 +213,16 @@ mod tests {
     }
 
     #[test]
-    fn mappings_are_whole_huge_pages() {
+    fn mappings_are_whole_small_pages_from_a_huge_page_boundary() {
         assert_eq!(mapped_len(THRESHOLD), HUGE);
-        assert_eq!(mapped_len(THRESHOLD + 1), 2 * HUGE);
-        assert_eq!(mapped_len(5 * HUGE), 5 * HUGE);
+        assert_eq!(mapped_len(THRESHOLD + 1), HUGE + PAGE);
+        let a = LargePages;
+        for size in [THRESHOLD, THRESHOLD + 1, 3 * HUGE + 12345] {
+            let layout = Layout::from_size_align(size, 8).unwrap();
+            let p = unsafe { a.alloc(layout) };
+            assert!(!p.is_null() && p as usize % HUGE == 0, "{size} bytes at {p:?}");
+            unsafe { *p.add(size - 1) = 1 };
+            unsafe { a.dealloc(p, layout) };
+        }
     }
 }
