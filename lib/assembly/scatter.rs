@@ -340,32 +340,15 @@ impl Assembly {
         F: Fn(usize, &mut HexVector) -> Result<(), E> + Sync,
         G: Fn(usize, &mut DVector<f64>, &mut DMatrix<f64>) -> Result<(), E> + Sync,
     {
-        // a zero-sized side output per hexahedron: nothing allocated
-        let mut none = vec![(); self.n_hex];
-        self.assemble_residual_with_side(pattern, |e, r, _: &mut ()| element(e, r), group, &mut none)
-    }
-
-    /// [`Self::assemble_residual_with_groups`], `element(e, r_e, side[e])` also
-    /// filling hexahedron `e`'s own entry of `side` (the Gauss stresses of the
-    /// state, for the results).
-    pub fn assemble_residual_with_side<E, F, G, T>(&mut self, pattern: &Pattern, element: F, group: G, side: &mut [T]) -> Result<&[f64], ElementFailure<E>>
-    where
-        E: Send,
-        T: Send,
-        F: Fn(usize, &mut HexVector, &mut T) -> Result<(), E> + Sync,
-        G: Fn(usize, &mut DVector<f64>, &mut DMatrix<f64>) -> Result<(), E> + Sync,
-    {
         assert!(self.fits(pattern), "Assembly workspace used with a different pattern than it was built for");
-        assert_eq!(side.len(), self.n_hex, "one side output per hexahedron");
         let start = std::time::Instant::now();
         let hex_failure = self
             .r_hex
             .par_iter_mut()
-            .zip(side.par_iter_mut())
             .enumerate()
-            .filter_map(|(e, (r, t))| {
+            .filter_map(|(e, r)| {
                 r.fill(0.0);
-                element(e, r, t).err().map(|error| (e, error))
+                element(e, r).err().map(|error| (e, error))
             })
             .min_by_key(|(e, _)| *e);
         if let Some((element, error)) = hex_failure {

@@ -310,7 +310,6 @@ fn integrate(
     form: Formulation,
     r: &mut ElementVector,
     mut k: Option<&mut ElementMatrix>,
-    mut stresses: Option<&mut GaussStresses>,
 ) -> Result<(), ElementError> {
     r.fill(0.0);
     if let Some(k) = k.as_deref_mut() {
@@ -334,9 +333,6 @@ fn integrate(
             } else {
                 let sigma = mat.stress(&F).map_err(err)?;
                 add_force_spatial(r, &G, &sigma, w);
-                if let Some(s) = stresses.as_deref_mut() {
-                    s[q] = row_major(&sigma);
-                }
             }
             continue;
         }
@@ -349,11 +345,7 @@ fn integrate(
             let (s, c) = mat.stress_tangent(&F).map_err(err)?;
             (s, Some(c))
         } else {
-            let sigma = mat.stress(&F).map_err(err)?;
-            if let Some(s) = stresses.as_deref_mut() {
-                s[q] = row_major(&sigma);
-            }
-            (sigma, None)
+            (mat.stress(&F).map_err(err)?, None)
         };
         match form {
             Formulation::UpdatedLagrangian => {
@@ -399,7 +391,7 @@ pub fn hex8_residual_tangent(
         // SAFETY: the CPU has AVX2 (checked just above)
         return unsafe { integrate_avx2(X, u, mat, form, r, k) };
     }
-    integrate(X, u, mat, form, r, Some(k), None)
+    integrate(X, u, mat, form, r, Some(k))
 }
 
 /// [`integrate`] compiled for AVX2: the 8-lane sums of [`SpatialStiffness`] in 4-lane
@@ -417,7 +409,7 @@ unsafe fn integrate_avx2(
     r: &mut ElementVector,
     k: &mut ElementMatrix,
 ) -> Result<(), ElementError> {
-    integrate(X, u, mat, form, r, Some(k), None)
+    integrate(X, u, mat, form, r, Some(k))
 }
 
 /// Internal force vector only (overwritten); cheaper than [`hex8_residual_tangent`].
@@ -428,29 +420,7 @@ pub fn hex8_residual(
     form: Formulation,
     r: &mut ElementVector,
 ) -> Result<(), ElementError> {
-    integrate(X, u, mat, form, r, None, None)
-}
-
-/// The Cauchy stress at the 8 Gauss points, row-major 3×3, as the results file holds it.
-pub type GaussStresses = [[f64; 9]; 8];
-
-fn row_major(sigma: &Matrix3<f64>) -> [f64; 9] {
-    std::array::from_fn(|i| sigma[(i / 3, i % 3)])
-}
-
-/// [`hex8_residual`] and the Cauchy stress at the Gauss points on the way, the same
-/// bits as [`hex8_gauss_stresses`] gives at the same state (the residual's own
-/// constitutive evaluation, row-major): the converged residual's pass then gives
-/// the results their stresses without a second pass over the elements.
-pub fn hex8_residual_and_stresses(
-    X: &[Vector3<f64>; 8],
-    u: &[Vector3<f64>; 8],
-    mat: &MaterialModel,
-    form: Formulation,
-    r: &mut ElementVector,
-    stresses: &mut GaussStresses,
-) -> Result<(), ElementError> {
-    integrate(X, u, mat, form, r, None, Some(stresses))
+    integrate(X, u, mat, form, r, None)
 }
 
 /// Strain energy of the element, Σ_q w_q det J₀ W(F_q) (its gradient is the internal
@@ -537,7 +507,7 @@ mod sparse_operator_tests {
             for form in [Formulation::UpdatedLagrangian, Formulation::TotalLagrangian] {
                 let (mut r1, mut k1, mut r2, mut k2) = (ElementVector::zeros(), ElementMatrix::zeros(), ElementVector::zeros(), ElementMatrix::zeros());
                 hex8_residual_tangent(&X, &u, mat, form, &mut r1, &mut k1).unwrap();
-                integrate(&X, &u, mat, form, &mut r2, Some(&mut k2), None).unwrap();
+                integrate(&X, &u, mat, form, &mut r2, Some(&mut k2)).unwrap();
                 assert!(r1.iter().zip(r2.iter()).all(|(a, b)| a.to_bits() == b.to_bits()), "{mat:?} {form:?}");
                 assert!(k1.iter().zip(k2.iter()).all(|(a, b)| a.to_bits() == b.to_bits()), "{mat:?} {form:?}");
             }

@@ -21,7 +21,7 @@ pub mod pressure;
 pub mod quadrature;
 
 pub use element::{
-    hex8_energy, hex8_gauss_stresses, hex8_min_jacobian, hex8_residual, hex8_residual_and_stresses, hex8_residual_tangent, ElementError, GaussStresses,
+    hex8_energy, hex8_gauss_stresses, hex8_min_jacobian, hex8_residual, hex8_residual_tangent, ElementError,
     ElementMatrix, ElementVector, Formulation,
 };
 pub use pressure::{follower_pressure_force, follower_pressure_force_stiffness, FaceMatrix, FaceVector};

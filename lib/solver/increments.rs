@@ -10,7 +10,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use super::log::{IterationEvent, SolveLog};
-use super::newton::{IncrementFailure, Newton, SetupFailure};
+use super::newton::{gauss_stresses, IncrementFailure, Newton, SetupFailure};
 use super::uzawa::solve_augmented;
 use crate::contact::pair::SlaveStatus;
 use crate::format::sccontact::MasterKind;
@@ -256,7 +256,7 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
                     let stress = if !out.writer {
                         Vec::new()
                     } else {
-                        match newton.gauss_stresses_at(&u) {
+                        match gauss_stresses(p, &u) {
                             Ok(s) => s,
                             Err((element, error)) => {
                                 let failure = IncrementFailure::Element { iteration: 0, element, error };

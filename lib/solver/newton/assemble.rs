@@ -16,7 +16,7 @@ use super::Newton;
 use crate::assembly::{Assembly, ElementFailure, DOFS_PER_NODE};
 use crate::contact::law::ContactElementError;
 use crate::contact::pair::PairSolver;
-use crate::fem::element::{hex8_residual, hex8_residual_and_stresses, hex8_residual_tangent, ElementError, GaussStresses};
+use crate::fem::element::{hex8_residual, hex8_residual_tangent, ElementError};
 use crate::fem::pressure::{follower_pressure_force_stiffness, FaceMatrix, FaceVector};
 use crate::solver::ranks;
 
@@ -138,24 +138,7 @@ impl Newton<'_> {
             Ok(())
         };
         let res = if tangent {
-            // a residual-only pass's stresses are of another state: released before
-            // the factorization that follows (peak memory)
-            (self.stresses, self.stresses_u) = (Vec::new(), Vec::new());
             self.assembly.assemble_with_groups(&self.pattern, hex, group).map(|(_, r)| r)
-        } else if self.partition.is_none() {
-            // the Gauss stresses on the way, for the results if this is the
-            // converged state (`gauss_stresses_at`)
-            let hex_residual = |e: usize, r: &mut _, s: &mut GaussStresses| {
-                let (X, ue, mat) = local(e);
-                hex8_residual_and_stresses(&X, &ue, mat, p.formulation, r, s).map_err(LocalFailure::Hex)
-            };
-            self.stresses_u.clear();
-            self.stresses.resize(p.hexes.len(), [[0.0; 9]; 8]);
-            let r = self.assembly.assemble_residual_with_side(&self.pattern, hex_residual, group, &mut self.stresses);
-            if r.is_ok() {
-                self.stresses_u.extend_from_slice(u);
-            }
-            r
         } else {
             let hex_residual = |e: usize, r: &mut _| {
                 let (X, ue, mat) = local(e);

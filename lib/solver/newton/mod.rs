@@ -46,7 +46,6 @@ use super::ranks;
 use super::stabilization::Stabilization;
 use crate::assembly::{Assembly, NodeGroups, Pattern, DOFS_PER_NODE};
 use crate::contact::pair::PairSolver;
-use crate::fem::GaussStresses;
 use crate::format::scres::IterationLog;
 use crate::format::setup::{LinearSolverChoice, LinearSolverSetup, NewtonSetup, OrderingChoice, PrecisionChoice};
 use crate::solver::gmres::GmresSettings;
@@ -139,10 +138,6 @@ pub struct Newton<'p> {
     /// Inexact Newton: an iterative linear solver's tolerance follows the residual
     /// (`None`: every solve to the solver's own tolerance).
     forcing: Option<Forcing>,
-    /// The Gauss stresses the last residual-only assembly evaluated, and the state
-    /// `u` they are of ([`Self::gauss_stresses_at`]); empty until one ran.
-    stresses: Vec<GaussStresses>,
-    stresses_u: Vec<f64>,
 }
 
 /// A converged increment's iteration history.
@@ -285,8 +280,6 @@ impl<'p> Newton<'p> {
             early_segmentation_hold: false,
             du_full: vec![0.0; n],
             forcing,
-            stresses: Vec::new(),
-            stresses_u: Vec::new(),
         })
     }
 
@@ -324,19 +317,6 @@ impl<'p> Newton<'p> {
     /// Slave nodes pressed into the master at the last search, over all pairs.
     pub fn n_contact_pressed(&self) -> usize {
         self.contact.iter().map(|c| c.n_pressed()).sum()
-    }
-
-    /// The Cauchy stress at every hexahedron's Gauss points at `u` (row-major), for
-    /// the results: those the last residual-only assembly evaluated when it was of
-    /// this very state (bit for bit; the converged iterate is usually checked that
-    /// way, [`NewtonSetup::residual_first`]), else a pass over the elements
-    /// ([`gauss_stresses`]), the same bits either way.
-    pub fn gauss_stresses_at(&mut self, u: &[f64]) -> Result<Vec<GaussStresses>, (usize, crate::fem::ElementError)> {
-        if !self.stresses.is_empty() && self.stresses_u == u {
-            self.stresses_u.clear();
-            return Ok(std::mem::take(&mut self.stresses));
-        }
-        gauss_stresses(self.problem, u)
     }
 
     pub fn n_free(&self) -> usize {
