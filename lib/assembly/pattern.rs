@@ -347,7 +347,8 @@ impl Pattern {
         (*self.symbolic).as_ref()
     }
 
-    /// Owned CSC pattern (cheap to clone for a solver that keeps it).
+    /// The CSC pattern itself (a copy is one `clone` away; a solver that keeps it
+    /// shares it instead: [`Self::shared`]).
     pub fn symbolic_owned(&self) -> &SymbolicSparseColMat<usize> {
         &self.symbolic
     }
