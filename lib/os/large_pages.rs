@@ -16,10 +16,11 @@
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicU8, Ordering};
 
-/// Blocks from this size on are mapped with huge pages advised.
-pub const THRESHOLD: usize = 2 << 20;
-/// A huge page: mappings are whole multiples of it.
+/// A transparent huge page (x86-64): mappings start on a multiple of it.
 const HUGE: usize = 2 << 20;
+/// Blocks from this size on are mapped with huge pages advised (a smaller one
+/// cannot hold a huge page).
+pub const THRESHOLD: usize = HUGE;
 /// The largest alignment a mapping gives by itself.
 const PAGE: usize = 4096;
 

@@ -62,7 +62,7 @@ use std::time::{Duration, Instant};
 use faer::sparse::{SymbolicSparseColMat, SymbolicSparseColMatRef};
 use rayon::prelude::*;
 
-use super::gmres::{gmres, GmresSettings};
+use super::gmres::{gmres, norm, GmresSettings};
 use super::linear::{check_values, FactorInfo, FaerDirect, FaerDirectOptions, Factorization, LinearSolver, LinearSolverError, SharedPattern, SolveReport, SolverTimings, Symmetry};
 
 /// A kept factorization gets at most this many times `reuse_below` GMRES
@@ -326,7 +326,7 @@ impl SymmetricPartGmres {
         }
         self.rhs.clear();
         self.rhs.extend_from_slice(rhs);
-        let b_norm = rhs.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let b_norm = norm(rhs);
         self.increment_rhs = self.increment_rhs.max(b_norm);
         // a fresh single-precision factor stands for a direct solve: GMRES to the
         // round-off floor a direct solve reaches (the floor stops it), not only to
