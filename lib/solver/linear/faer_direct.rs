@@ -40,14 +40,14 @@
 //! the same, bit for bit, for any number of rayon threads.
 
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, simplicial::SimplicialLltRef, supernodal::SupernodalLltRef, LdltRef, LltRef,
+    factorize_symbolic_cholesky, simplicial::SimplicialLltRef, supernodal::{SupernodalLltRef, SymbolicSupernodalCholesky}, LdltRef, LltRef,
     SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
 };
 use faer::sparse::linalg::lu::{factorize_symbolic_lu, LuRef, NumericLu, SymbolicLu};
@@ -190,6 +190,9 @@ pub struct FaerDirect {
     n_numeric: usize,
     solve_nanos: AtomicU64,
     n_solve: AtomicU64,
+    /// The work arrays of a tree solve (kept from one solve to the next: a Krylov
+    /// solve applies the factor every iteration).
+    solve_scratch: Mutex<SolveScratch>,
 }
 
 impl Default for FaerDirect {
@@ -220,6 +223,7 @@ impl FaerDirect {
             n_numeric: 0,
             solve_nanos: AtomicU64::new(0),
             n_solve: AtomicU64::new(0),
+            solve_scratch: Mutex::new(SolveScratch::default()),
         }
     }
 
@@ -621,6 +625,15 @@ impl FaerDirect {
         self.pattern.as_deref()
     }
 
+    /// The elimination tree, the supernodal symbolic factor and the forward
+    /// permutation of a tree solve of an `LLᵀ` factor (`None`: faer's solve).
+    fn tree_solve<'a>(&'a self, sym: &'a SymbolicCholesky<usize>) -> Option<(&'a TreeCholesky, &'a SymbolicSupernodalCholesky<usize>, &'a [usize])> {
+        match (&self.tree, sym.raw(), sym.perm()) {
+            (Some(tree), SymbolicCholeskyRaw::Supernodal(s), Some(perm)) => Some((tree, s, perm.arrays().0)),
+            _ => None,
+        }
+    }
+
     /// [`LinearSolver::solve_in_place`] without exclusive access (the factor is only
     /// read), so that a preconditioner can solve while its owner is borrowed.
     pub fn solve(&self, rhs: &mut [f64]) -> Result<(), LinearSolverError> {
@@ -635,6 +648,28 @@ impl FaerDirect {
         }
         let faer_err = |e: faer::dyn_stack::mem::AllocError| LinearSolverError::Faer(format!("{e:?}"));
         match (&self.symbolic, &self.numeric) {
+            (Some(Symbolic::Cholesky(sym)), Numeric::Llt) if self.tree_solve(sym).is_some() => {
+                let (tree, s, fwd) = self.tree_solve(sym).expect("checked by the guard");
+                let mut scratch = self.solve_scratch.lock().unwrap_or_else(|e| e.into_inner());
+                let SolveScratch { z, w, .. } = &mut *scratch;
+                z.clear();
+                z.extend(fwd.iter().map(|&i| rhs[i]));
+                tree.solve_in_place(s, &self.l_values, z, w);
+                fwd.iter().zip(z.iter()).for_each(|(&i, &v)| rhs[i] = v);
+            }
+            (Some(Symbolic::Cholesky(sym)), &Numeric::LltSingle { scale }) if self.tree_solve(sym).is_some() => {
+                let (tree, s, fwd) = self.tree_solve(sym).expect("checked by the guard");
+                // A⁻¹ b = scale (scale A)⁻¹ b, with b scaled by a power of two into f32's range
+                let largest = rhs.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                let b_scale = inverse_power_of_two(largest).unwrap_or(1.0);
+                let mut scratch = self.solve_scratch.lock().unwrap_or_else(|e| e.into_inner());
+                let SolveScratch { z32: z, w32: w, .. } = &mut *scratch;
+                z.clear();
+                z.extend(fwd.iter().map(|&i| (rhs[i] * b_scale) as f32));
+                tree.solve_in_place(s, &self.l_values32, z, w);
+                let back = scale / b_scale;
+                fwd.iter().zip(z.iter()).for_each(|(&i, &v)| rhs[i] = back * f64::from(v));
+            }
             (Some(Symbolic::Cholesky(sym)), Numeric::Llt) => {
                 let x = MatMut::from_column_major_slice_mut(rhs, n, 1);
                 let mut buf = MemBuffer::try_new(sym.solve_in_place_scratch::<f64>(1, par)).map_err(faer_err)?;
@@ -671,6 +706,16 @@ impl FaerDirect {
         Ok(())
     }
 
+}
+
+/// The work arrays of a tree solve ([`TreeCholesky::solve_in_place`]) in each
+/// precision: the permuted right-hand side and the supernodes' updates.
+#[derive(Default)]
+struct SolveScratch {
+    z: Vec<f64>,
+    w: Vec<f64>,
+    z32: Vec<f32>,
+    w32: Vec<f32>,
 }
 
 /// What `analyse` makes of a pattern: everything a numeric factorization reads.

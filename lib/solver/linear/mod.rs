@@ -15,11 +15,13 @@
 //! | [`error`] | [`LinearSolverError`] |
 //! | [`faer_direct`] | the faer backend: ordering and symbolic factorization once, `LLᵀ` → `LDLᵀ` or `LU` per Newton iteration, the singularity check |
 //! | [`tree_cholesky`] | the numeric supernodal `LLᵀ`, parallel over the elimination tree, into faer's factor layout |
+//! | [`tree_solve`] | the triangular solves with that factor, parallel over the same tree |
 
 pub mod dense_kernels;
 pub mod error;
 pub mod faer_direct;
 pub mod tree_cholesky;
+pub mod tree_solve;
 pub mod interface;
 
 pub use error::LinearSolverError;

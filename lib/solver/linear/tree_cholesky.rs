@@ -117,21 +117,24 @@ const TASK_FLOPS: f64 = 2.0e6;
 #[derive(Debug, Clone)]
 pub struct TreeCholesky {
     /// `children[s]`: the supernodes whose parent is `s`, increasing.
-    children: Vec<Vec<usize>>,
+    pub(super) children: Vec<Vec<usize>>,
     /// Roots of the forest, increasing.
-    roots: Vec<usize>,
+    pub(super) roots: Vec<usize>,
     /// Flops of the factorization of the subtree of `s` (its own and its
     /// descendants').
     subtree_flops: Vec<f64>,
     /// `updaters[s]`: the descendants `d` whose row pattern meets the columns of
     /// `s`, increasing.
-    updaters: Vec<Vec<usize>>,
+    pub(super) updaters: Vec<Vec<usize>>,
+    /// Entries of the factor in the subtree of `s` (the work of its triangular
+    /// solves, [`super::tree_solve`]).
+    pub(super) subtree_entries: Vec<usize>,
 }
 
 /// The raw value array shared by the tasks (see the module's **Safety**).
-struct SharedValues<T> {
-    ptr: *mut T,
-    len: usize,
+pub(super) struct SharedValues<T> {
+    pub(super) ptr: *mut T,
+    pub(super) len: usize,
 }
 impl<T> Clone for SharedValues<T> {
     fn clone(&self) -> Self {
@@ -150,7 +153,7 @@ impl<T> SharedValues<T> {
     /// # Safety
     /// `offset + len` within the array, and no one writes them while the slice
     /// lives.
-    unsafe fn slice(&self, offset: usize, len: usize) -> &[T] {
+    pub(super) unsafe fn slice(&self, offset: usize, len: usize) -> &[T] {
         assert!(offset + len <= self.len, "a block inside the value array");
         // SAFETY: in bounds (checked); not written by the caller's contract
         unsafe { std::slice::from_raw_parts(self.ptr.add(offset), len) }
@@ -162,7 +165,7 @@ impl<T> SharedValues<T> {
     /// `offset + len` within the array, and no one else reads or writes them
     /// while the slice lives.
     #[allow(clippy::mut_from_ref)]
-    unsafe fn slice_mut(&self, offset: usize, len: usize) -> &mut [T] {
+    pub(super) unsafe fn slice_mut(&self, offset: usize, len: usize) -> &mut [T] {
         assert!(offset + len <= self.len, "a block inside the value array");
         // SAFETY: in bounds (checked); exclusive by the caller's contract
         unsafe { std::slice::from_raw_parts_mut(self.ptr.add(offset), len) }
@@ -206,12 +209,14 @@ impl TreeCholesky {
         let mut roots = Vec::new();
         let mut updaters = vec![Vec::new(); n_super];
         let mut own_flops = vec![0.0; n_super];
+        let mut subtree_entries = vec![0usize; n_super];
         for d in 0..n_super {
             let pattern = &rows[row_ptr[d]..row_ptr[d + 1]];
             let c = (end[d] - begin[d]) as f64;
             let m = pattern.len() as f64;
             // chol of the c × c block, the m × c triangular solve, the updates it sends
             own_flops[d] = c * c * c / 3.0 + m * c * c + m * m * c;
+            subtree_entries[d] = (end[d] - begin[d]) * (end[d] - begin[d] + pattern.len());
             match pattern.first() {
                 Some(&r) => children[super_of[r]].push(d),
                 None => roots.push(d),
@@ -231,9 +236,25 @@ impl TreeCholesky {
             for &c in &children[s] {
                 let f = subtree_flops[c];
                 subtree_flops[s] += f;
+                let e = subtree_entries[c];
+                subtree_entries[s] += e;
             }
         }
-        Self { children, roots, subtree_flops, updaters }
+        Self { children, roots, subtree_flops, updaters, subtree_entries }
+    }
+
+    /// `visit` every supernode of the subtree of `root`, children before parents
+    /// (without recursion: chains can be long).
+    pub(super) fn each_in_postorder(&self, root: usize, mut visit: impl FnMut(usize)) {
+        let mut stack = vec![(root, false)];
+        while let Some((t, expanded)) = stack.pop() {
+            if expanded {
+                visit(t);
+            } else {
+                stack.push((t, true));
+                stack.extend(self.children[t].iter().rev().map(|&c| (c, false)));
+            }
+        }
     }
 
     /// Whether the subtree of `s` runs as one sequential task: it is light, or a
@@ -332,16 +353,7 @@ impl<T: FactorReal> Context<'_, T> {
         }
         if tree.light(bottom) {
             chain.pop();
-            // children before parents, without recursion
-            let mut stack = vec![(bottom, false)];
-            while let Some((t, expanded)) = stack.pop() {
-                if expanded {
-                    self.supernode(t, Par::Seq);
-                } else {
-                    stack.push((t, true));
-                    stack.extend(tree.children[t].iter().rev().map(|&c| (c, false)));
-                }
-            }
+            tree.each_in_postorder(bottom, |t| self.supernode(t, Par::Seq));
         } else {
             let kids = &tree.children[bottom];
             rayon::scope(|scope| {
@@ -489,7 +501,7 @@ impl<T: FactorReal> Context<'_, T> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::solver::bench::{elastic_cube_system, relative_residual};
     use crate::solver::linear::{FaerDirect, FaerDirectOptions, LinearSolver, LinearSolverError, SymmetricStrategy, Symmetry};
@@ -502,10 +514,10 @@ mod tests {
 
     /// A symmetric matrix (both triangles stored), its supernodal symbolic factor
     /// (METIS ordering, as `FaerDirect` makes it) and the lower triangle of `P A Pᵀ`.
-    struct Problem {
-        p: SymbolicSparseColMat<usize>,
-        v: Vec<f64>,
-        sym: SymbolicCholesky<usize>,
+    pub(in crate::solver::linear) struct Problem {
+        pub(in crate::solver::linear) p: SymbolicSparseColMat<usize>,
+        pub(in crate::solver::linear) v: Vec<f64>,
+        pub(in crate::solver::linear) sym: SymbolicCholesky<usize>,
         lower: (Vec<usize>, Vec<usize>, Vec<f64>),
     }
 
@@ -528,7 +540,7 @@ mod tests {
             Self { p, v, sym, lower: (cp, ri, val) }
         }
 
-        fn supernodal(&self) -> &SymbolicSupernodalCholesky<usize> {
+        pub(in crate::solver::linear) fn supernodal(&self) -> &SymbolicSupernodalCholesky<usize> {
             match self.sym.raw() {
                 SymbolicCholeskyRaw::Supernodal(s) => s,
                 SymbolicCholeskyRaw::Simplicial(_) => panic!("a supernodal factor"),
@@ -542,7 +554,7 @@ mod tests {
 
         /// The tree factorization of `scale · A` in any precision, on `threads`
         /// rayon threads.
-        fn tree_factor_scaled<T: FactorReal>(&self, threads: usize, par: Par, scale: f64) -> Result<Vec<T>, LltError> {
+        pub(in crate::solver::linear) fn tree_factor_scaled<T: FactorReal>(&self, threads: usize, par: Par, scale: f64) -> Result<Vec<T>, LltError> {
             let s = self.supernodal();
             let (cp, ri, val) = &self.lower;
             let n = self.p.nrows();
@@ -564,7 +576,7 @@ mod tests {
         }
     }
 
-    fn cube(n: usize) -> Problem {
+    pub(in crate::solver::linear) fn cube(n: usize) -> Problem {
         let cube = elastic_cube_system(n).unwrap();
         Problem::new(cube.pattern.symbolic_owned().clone(), cube.assembly.values().to_vec())
     }
