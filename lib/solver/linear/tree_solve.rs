@@ -294,4 +294,38 @@ mod tests {
             assert_eq!(one, single(threads), "{threads} threads, single precision");
         }
     }
+
+    /// One solve through the 18³ elastic cube's single-precision factor, by the
+    /// tree on 1 and 2 threads and by faer's sequential solve (means of 20; docs/performance.md):
+    /// `cargo test --release --lib bench_tree_solve -- --ignored --nocapture`.
+    #[test]
+    #[ignore = "a benchmark: prints times"]
+    fn bench_tree_solve() {
+        let pb = cube(18);
+        let l: Vec<f32> = pb.tree_factor_scaled(2, Par::Seq, 0.25).unwrap();
+        let s = pb.supernodal();
+        let tree = TreeCholesky::new(s);
+        let n = pb.p.nrows();
+        eprintln!("{n} unknowns, {} factor entries", l.len());
+        let mean_ms = |f: &mut dyn FnMut()| {
+            f();
+            let t = std::time::Instant::now();
+            for _ in 0..20 {
+                f();
+            }
+            t.elapsed().as_secs_f64() * 1e3 / 20.0
+        };
+        for threads in [1, 2] {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("a thread pool");
+            let (mut z, mut w) = (vec![1.0f32; n], Vec::new());
+            let ms = pool.install(|| mean_ms(&mut || tree.solve_in_place(s, &l, &mut z, &mut w)));
+            eprintln!("tree solve, {threads} threads: {ms:.3} ms");
+        }
+        let mut x = vec![1.0f32; n];
+        let mut buf = MemBuffer::new(pb.sym.solve_in_place_scratch::<f32>(1, Par::Seq));
+        let ms = mean_ms(&mut || {
+            LltRef::new(&pb.sym, &l).solve_in_place_with_conj(Conj::No, MatMut::from_column_major_slice_mut(&mut x, n, 1), Par::Seq, MemStack::new(&mut buf));
+        });
+        eprintln!("faer's solve: {ms:.3} ms");
+    }
 }
