@@ -650,8 +650,11 @@ impl FaerDirect {
         match (&self.symbolic, &self.numeric) {
             (Some(Symbolic::Cholesky(sym)), Numeric::Llt) if self.tree_solve(sym).is_some() => {
                 let (tree, s, fwd) = self.tree_solve(sym).expect("checked by the guard");
-                let mut scratch = self.solve_scratch.lock().unwrap_or_else(|e| e.into_inner());
-                let SolveScratch { z, w, .. } = &mut *scratch;
+                // a solve already under way on this solver (another thread's, or one a
+                // waiting rayon worker took up) keeps the kept arrays: this one makes its own
+                let (mut held, mut own) = (self.solve_scratch.try_lock().ok(), SolveScratch::default());
+                let scratch = held.as_deref_mut().unwrap_or(&mut own);
+                let SolveScratch { z, w, .. } = scratch;
                 z.clear();
                 z.extend(fwd.iter().map(|&i| rhs[i]));
                 tree.solve_in_place(s, &self.l_values, z, w);
@@ -662,8 +665,11 @@ impl FaerDirect {
                 // A⁻¹ b = scale (scale A)⁻¹ b, with b scaled by a power of two into f32's range
                 let largest = rhs.iter().fold(0.0f64, |m, v| m.max(v.abs()));
                 let b_scale = inverse_power_of_two(largest).unwrap_or(1.0);
-                let mut scratch = self.solve_scratch.lock().unwrap_or_else(|e| e.into_inner());
-                let SolveScratch { z32: z, w32: w, .. } = &mut *scratch;
+                // a solve already under way on this solver (another thread's, or one a
+                // waiting rayon worker took up) keeps the kept arrays: this one makes its own
+                let (mut held, mut own) = (self.solve_scratch.try_lock().ok(), SolveScratch::default());
+                let scratch = held.as_deref_mut().unwrap_or(&mut own);
+                let SolveScratch { z32: z, w32: w, .. } = scratch;
                 z.clear();
                 z.extend(fwd.iter().map(|&i| (rhs[i] * b_scale) as f32));
                 tree.solve_in_place(s, &self.l_values32, z, w);
