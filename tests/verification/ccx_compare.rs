@@ -19,7 +19,8 @@ fn compare_with(model: &str, level: &str, options: &[&str]) -> serde_yaml::Value
     let bin_dir = std::path::Path::new(env!("CARGO_BIN_EXE_sc-solve")).parent().unwrap();
     let o = Command::new(python())
         .arg(repo().join("docs/scripts/ccx_compare.py"))
-        .args([model, "--levels", level, "--threads", "2", "--json"])
+        // one run of each program: the answers are checked, not the times
+        .args([model, "--levels", level, "--threads", "2", "--repeat", "1", "--json"])
         .args(options)
         .arg("--out")
         .arg(out.path())
