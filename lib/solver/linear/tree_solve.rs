@@ -40,8 +40,9 @@ const TASK_ENTRIES: usize = 1 << 15;
 impl TreeCholesky {
     /// Solve `L Lᵀ x = b` in place (`x = b` on entry), in the symbolic factor's
     /// permuted order; `l_values` is the factor of [`TreeCholesky::factor`] (or
-    /// any factor in faer's supernodal layout of `symbolic`). The subtrees run on
-    /// rayon's pool.
+    /// any factor in faer's supernodal layout of `symbolic`); `work` holds the
+    /// supernodes' updates `w_s` (resized here; keep it between solves). The
+    /// subtrees run on rayon's pool.
     pub fn solve_in_place<T: FactorReal>(&self, symbolic: &SymbolicSupernodalCholesky<usize>, l_values: &[T], x: &mut [T], work: &mut Vec<T>) {
         assert_eq!(l_values.len(), symbolic.len_val(), "the value array must match the symbolic factor");
         assert_eq!(x.len(), symbolic.nrows(), "the right-hand side must match the symbolic factor");
