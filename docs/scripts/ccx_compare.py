@@ -33,8 +33,8 @@ ccx's memory), --linear-solver M (ours: auto, lu, gmres, cholesky...), --orderin
 `integration`; the pipeline's when not given), --ccx-ran R (ccx's *CONTROLS FIELD R_n = C_n; default
 the model's, else our Newton tolerance), --mpi-ranks P (ours under `mpirun -np P`, each rank
 with T/P threads; needs a build with --features petsc; the peak RSS is then the
-largest rank's), --repeat N and --repeat-below S (above), --json, --plot PNG (log-log time against dofs; needs matplotlib
-in the venv).
+largest rank's), --repeat N and --repeat-below S (above), --json, --plot PNG
+(log-log time against dofs; needs matplotlib in the venv).
 Exit code 0 when both finished and agree within the tolerances below at every
 level, 1 otherwise (the table says where).
 """
@@ -97,10 +97,16 @@ def run_measured(cmd, cwd, env, log_path):
     return rc, wall, peak_mb
 
 
-def repeat_more(walls, a):
-    """Whether a program that took `walls` so far runs once more (--repeat,
-    --repeat-below): both programs are measured alike."""
-    return len(walls) < a.repeat and max(walls) < a.repeat_below
+def repeated(run, a):
+    """Call `run()` -> (result, ok, wall seconds) up to --repeat times while each
+    call took under --repeat-below seconds and succeeded (both programs are
+    measured alike); (the last result, every wall time)."""
+    walls = []
+    while True:
+        result, ok, wall = run()
+        walls.append(wall)
+        if not ok or len(walls) >= a.repeat or max(walls) >= a.repeat_below:
+            return result, walls
 
 
 def gmsh_exe():
@@ -219,14 +225,15 @@ def run_level(model, spec, n, a, out_root):
         # Open MPI refuses root unless told
         env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
         cmd = ["mpirun", "-np", str(a.mpi_ranks), "--oversubscribe", *cmd]
-    walls, rss = [], 0.0
-    while True:
+    peaks = []
+
+    def ours_once():
         rc, wall, peak = run_measured(cmd, level_dir, env, level_dir / (name + ".solve.log"))
-        walls.append(wall)
-        rss = max(rss, peak or 0.0)
-        if rc != 0 or not repeat_more(walls, a):
-            break
-    wall = statistics.median(walls)
+        peaks.append(peak or 0.0)
+        return rc, rc == 0, wall
+
+    rc, walls = repeated(ours_once, a)
+    wall, rss = statistics.median(walls), max(peaks)
     log = (level_dir / (name + ".solve.log")).read_text()
     m = re.search(r"(\d+) free dofs", log)
     row["dofs"] = int(m.group(1)) if m else None
@@ -254,13 +261,14 @@ def run_level(model, spec, n, a, out_root):
     old = {k: os.environ.get(k) for k in ("OMP_NUM_THREADS", "CCX_NPROC_EQUATION_SOLVER")}
     os.environ.update(OMP_NUM_THREADS=threads, CCX_NPROC_EQUATION_SOLVER=threads)
     try:
-        walls, peaks = [], []
-        while True:
+        peaks = []
+
+        def ccx_once():
             res = deck.run_ccx(text, cmodel, ccx_dir, a.ccx)
-            walls.append(res["wall_seconds"])
             peaks.append(res.get("peak_rss_mb") or 0.0)
-            if not res["ok"] or not repeat_more(walls, a):
-                break
+            return res, res["ok"], res["wall_seconds"]
+
+        res, walls = repeated(ccx_once, a)
         res["wall_seconds"] = statistics.median(walls)
         res["wall_runs"] = walls
         res["peak_rss_mb"] = max(peaks) if any(peaks) else res.get("peak_rss_mb")

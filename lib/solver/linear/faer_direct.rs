@@ -60,7 +60,7 @@ use faer::perm::PermRef;
 use faer::{Conj, MatMut, Par, Side};
 
 use super::error::LinearSolverError;
-use super::tree_cholesky::TreeCholesky;
+use super::tree_cholesky::{FactorReal, TreeCholesky};
 use crate::solver::ordering::{geometric_dissection, nested_dissection, FillOrdering};
 use super::interface::{check_values, FactorInfo, Factorization, LinearSolver, SharedPattern, SolverTimings, Symmetry};
 
@@ -625,13 +625,32 @@ impl FaerDirect {
         self.pattern.as_deref()
     }
 
-    /// The elimination tree, the supernodal symbolic factor and the forward
-    /// permutation of a tree solve of an `LLᵀ` factor (`None`: faer's solve).
-    fn tree_solve<'a>(&'a self, sym: &'a SymbolicCholesky<usize>) -> Option<(&'a TreeCholesky, &'a SymbolicSupernodalCholesky<usize>, &'a [usize])> {
-        match (&self.tree, sym.raw(), sym.perm()) {
-            (Some(tree), SymbolicCholeskyRaw::Supernodal(s), Some(perm)) => Some((tree, s, perm.arrays().0)),
-            _ => None,
+    /// Solve in place by the elimination tree ([`TreeCholesky::solve_in_place`])
+    /// when the factor held is an `LLᵀ` that the tree made (double, or single of
+    /// `scale · A`); `false`, untouched, otherwise (faer's solve).
+    fn solve_by_tree(&self, rhs: &mut [f64]) -> bool {
+        let (Some(tree), Some(Symbolic::Cholesky(sym))) = (&self.tree, &self.symbolic) else {
+            return false;
+        };
+        let (SymbolicCholeskyRaw::Supernodal(s), Some(perm)) = (sym.raw(), sym.perm()) else {
+            return false;
+        };
+        let fwd = perm.arrays().0;
+        // a solve already under way on this solver (another thread's, or one a
+        // waiting rayon worker took up) keeps the kept arrays: this one makes its own
+        let (mut held, mut own) = (self.solve_scratch.try_lock().ok(), SolveScratch::default());
+        let scratch = held.as_deref_mut().unwrap_or(&mut own);
+        match self.numeric {
+            Numeric::Llt => permuted_tree_solve(tree, s, fwd, &self.l_values, rhs, |v| v, |v| v, &mut scratch.z, &mut scratch.w),
+            Numeric::LltSingle { scale } => {
+                // A⁻¹ b = scale (scale A)⁻¹ b
+                let b_scale = single_rhs_scale(rhs);
+                let back = scale / b_scale;
+                permuted_tree_solve(tree, s, fwd, &self.l_values32, rhs, |v| (v * b_scale) as f32, |v| back * f64::from(v), &mut scratch.z32, &mut scratch.w32);
+            }
+            _ => return false,
         }
+        true
     }
 
     /// [`LinearSolver::solve_in_place`] without exclusive access (the factor is only
@@ -647,62 +666,36 @@ impl FaerDirect {
             return Err(LinearSolverError::Dimension { what: "right-hand side entries", expected: n, got: rhs.len() });
         }
         let faer_err = |e: faer::dyn_stack::mem::AllocError| LinearSolverError::Faer(format!("{e:?}"));
-        match (&self.symbolic, &self.numeric) {
-            (Some(Symbolic::Cholesky(sym)), Numeric::Llt) if self.tree_solve(sym).is_some() => {
-                let (tree, s, fwd) = self.tree_solve(sym).expect("checked by the guard");
-                // a solve already under way on this solver (another thread's, or one a
-                // waiting rayon worker took up) keeps the kept arrays: this one makes its own
-                let (mut held, mut own) = (self.solve_scratch.try_lock().ok(), SolveScratch::default());
-                let scratch = held.as_deref_mut().unwrap_or(&mut own);
-                let SolveScratch { z, w, .. } = scratch;
-                z.clear();
-                z.extend(fwd.iter().map(|&i| rhs[i]));
-                tree.solve_in_place(s, &self.l_values, z, w);
-                fwd.iter().zip(z.iter()).for_each(|(&i, &v)| rhs[i] = v);
+        // the tree's own solve for the factors it made, faer's for the others
+        if !self.solve_by_tree(rhs) {
+            match (&self.symbolic, &self.numeric) {
+                (Some(Symbolic::Cholesky(sym)), Numeric::Llt) => {
+                    let x = MatMut::from_column_major_slice_mut(rhs, n, 1);
+                    let mut buf = MemBuffer::try_new(sym.solve_in_place_scratch::<f64>(1, par)).map_err(faer_err)?;
+                    LltRef::new(sym, &self.l_values).solve_in_place_with_conj(Conj::No, x, par, MemStack::new(&mut buf));
+                }
+                (Some(Symbolic::Cholesky(sym)), &Numeric::LltSingle { scale }) => {
+                    // A⁻¹ b = scale (scale A)⁻¹ b
+                    let b_scale = single_rhs_scale(rhs);
+                    let mut x32: Vec<f32> = rhs.iter().map(|&v| (v * b_scale) as f32).collect();
+                    let mut buf = MemBuffer::try_new(sym.solve_in_place_scratch::<f32>(1, par)).map_err(faer_err)?;
+                    let x = MatMut::from_column_major_slice_mut(&mut x32, n, 1);
+                    LltRef::new(sym, &self.l_values32).solve_in_place_with_conj(Conj::No, x, par, MemStack::new(&mut buf));
+                    let back = scale / b_scale;
+                    rhs.iter_mut().zip(&x32).for_each(|(r, &v)| *r = back * f64::from(v));
+                }
+                (Some(Symbolic::Cholesky(sym)), Numeric::Ldlt) => {
+                    let mut buf = MemBuffer::try_new(sym.solve_in_place_scratch::<f64>(1, par)).map_err(faer_err)?;
+                    let x = MatMut::from_column_major_slice_mut(rhs, n, 1);
+                    LdltRef::new(sym, &self.l_values).solve_in_place_with_conj(Conj::No, x, par, MemStack::new(&mut buf));
+                }
+                (Some(Symbolic::Lu(sym)), Numeric::Lu(num)) => {
+                    let mut buf = MemBuffer::try_new(sym.solve_in_place_scratch::<f64>(1, par)).map_err(faer_err)?;
+                    let x = MatMut::from_column_major_slice_mut(rhs, n, 1);
+                    LuRef::new_unchecked(sym, num).solve_in_place_with_conj(Conj::No, x, par, MemStack::new(&mut buf));
+                }
+                _ => return Err(LinearSolverError::Order("solve_in_place", "a successful factor")),
             }
-            (Some(Symbolic::Cholesky(sym)), &Numeric::LltSingle { scale }) if self.tree_solve(sym).is_some() => {
-                let (tree, s, fwd) = self.tree_solve(sym).expect("checked by the guard");
-                // A⁻¹ b = scale (scale A)⁻¹ b, with b scaled by a power of two into f32's range
-                let largest = rhs.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-                let b_scale = inverse_power_of_two(largest).unwrap_or(1.0);
-                // a solve already under way on this solver (another thread's, or one a
-                // waiting rayon worker took up) keeps the kept arrays: this one makes its own
-                let (mut held, mut own) = (self.solve_scratch.try_lock().ok(), SolveScratch::default());
-                let scratch = held.as_deref_mut().unwrap_or(&mut own);
-                let SolveScratch { z32: z, w32: w, .. } = scratch;
-                z.clear();
-                z.extend(fwd.iter().map(|&i| (rhs[i] * b_scale) as f32));
-                tree.solve_in_place(s, &self.l_values32, z, w);
-                let back = scale / b_scale;
-                fwd.iter().zip(z.iter()).for_each(|(&i, &v)| rhs[i] = back * f64::from(v));
-            }
-            (Some(Symbolic::Cholesky(sym)), Numeric::Llt) => {
-                let x = MatMut::from_column_major_slice_mut(rhs, n, 1);
-                let mut buf = MemBuffer::try_new(sym.solve_in_place_scratch::<f64>(1, par)).map_err(faer_err)?;
-                LltRef::new(sym, &self.l_values).solve_in_place_with_conj(Conj::No, x, par, MemStack::new(&mut buf));
-            }
-            (Some(Symbolic::Cholesky(sym)), &Numeric::LltSingle { scale }) => {
-                // A⁻¹ b = scale (scale A)⁻¹ b, with b scaled by a power of two into f32's range
-                let largest = rhs.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-                let b_scale = inverse_power_of_two(largest).unwrap_or(1.0);
-                let mut x32: Vec<f32> = rhs.iter().map(|&v| (v * b_scale) as f32).collect();
-                let mut buf = MemBuffer::try_new(sym.solve_in_place_scratch::<f32>(1, par)).map_err(faer_err)?;
-                let x = MatMut::from_column_major_slice_mut(&mut x32, n, 1);
-                LltRef::new(sym, &self.l_values32).solve_in_place_with_conj(Conj::No, x, par, MemStack::new(&mut buf));
-                let back = scale / b_scale;
-                rhs.iter_mut().zip(&x32).for_each(|(r, &v)| *r = back * f64::from(v));
-            }
-            (Some(Symbolic::Cholesky(sym)), Numeric::Ldlt) => {
-                let mut buf = MemBuffer::try_new(sym.solve_in_place_scratch::<f64>(1, par)).map_err(faer_err)?;
-                let x = MatMut::from_column_major_slice_mut(rhs, n, 1);
-                LdltRef::new(sym, &self.l_values).solve_in_place_with_conj(Conj::No, x, par, MemStack::new(&mut buf));
-            }
-            (Some(Symbolic::Lu(sym)), Numeric::Lu(num)) => {
-                let mut buf = MemBuffer::try_new(sym.solve_in_place_scratch::<f64>(1, par)).map_err(faer_err)?;
-                let x = MatMut::from_column_major_slice_mut(rhs, n, 1);
-                LuRef::new_unchecked(sym, num).solve_in_place_with_conj(Conj::No, x, par, MemStack::new(&mut buf));
-            }
-            _ => return Err(LinearSolverError::Order("solve_in_place", "a successful factor")),
         }
         self.solve_nanos.fetch_add(start.elapsed().as_nanos() as u64, Ordering::Relaxed);
         self.n_solve.fetch_add(1, Ordering::Relaxed);
@@ -712,6 +705,33 @@ impl FaerDirect {
         Ok(())
     }
 
+}
+
+/// The power of two that brings a right-hand side into `f32`'s range for a
+/// single-precision solve (1 for a zero one).
+fn single_rhs_scale(rhs: &[f64]) -> f64 {
+    let largest = rhs.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    inverse_power_of_two(largest).unwrap_or(1.0)
+}
+
+/// `rhs ← (L Lᵀ)⁻¹ rhs` through the tree's solve of `P rhs` (`fwd`: the forward
+/// permutation), each entry converted `into` the factor's precision and `back`.
+#[allow(clippy::too_many_arguments)]
+fn permuted_tree_solve<T: FactorReal>(
+    tree: &TreeCholesky,
+    symbolic: &SymbolicSupernodalCholesky<usize>,
+    fwd: &[usize],
+    l_values: &[T],
+    rhs: &mut [f64],
+    into: impl Fn(f64) -> T,
+    back: impl Fn(T) -> f64,
+    z: &mut Vec<T>,
+    w: &mut Vec<T>,
+) {
+    z.clear();
+    z.extend(fwd.iter().map(|&i| into(rhs[i])));
+    tree.solve_in_place(symbolic, l_values, z, w);
+    fwd.iter().zip(z.iter()).for_each(|(&i, &v)| rhs[i] = back(v));
 }
 
 /// The work arrays of a tree solve ([`TreeCholesky::solve_in_place`]) in each
