@@ -31,6 +31,8 @@ struct Args {
 }
 
 fn main() -> ExitCode {
+    // the origin of SC_TIMELINE=1's timeline (lib/os/timeline.rs)
+    splinecontact::os::timeline::epoch();
     let args = Args::parse();
     match splinecontact::solver::ranks::participate("sc-pipeline", false) {
         Ok(splinecontact::solver::ranks::Participation::Idle) => return ExitCode::SUCCESS,
@@ -50,7 +52,11 @@ fn main() -> ExitCode {
     let verbosity = if quiet { splinecontact::solver::log::Verbosity::Quiet } else { splinecontact::solver::log::Verbosity::Normal };
     // warnings are said even when quiet
     let mut warn = |line: &str| eprintln!("warning: {line}");
-    match splinecontact::pipeline::run(&args.pipeline, verbosity, &mut log, &mut warn) {
+    let outcome = splinecontact::pipeline::run(&args.pipeline, verbosity, &mut log, &mut warn);
+    if splinecontact::os::timeline::enabled() {
+        eprint!("{}", splinecontact::os::timeline::render(&splinecontact::os::timeline::entries()));
+    }
+    match outcome {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("sc-pipeline: error: {e}");

@@ -11,6 +11,7 @@ use clap::Parser;
 use splinecontact::format::setup::SolveSetup;
 use splinecontact::solver::log::Verbosity;
 use splinecontact::solver::ranks::{self, Participation};
+use splinecontact::os::timeline;
 use splinecontact::stages::solve;
 
 /// Solve a finite-strain static problem on a .scmesh, or a contact problem on the
@@ -63,6 +64,11 @@ use splinecontact::stages::solve;
 /// contact search, assembly, factorization and solve per Newton iteration. Exit codes: 0 done, 2 bad
 /// input, 3 stopped without convergence (converged increments kept), 1 I/O.
 ///
+/// Environment: SC_TIMELINE=1 prints the run's phases at the end (start, end and
+/// length in ms, the thread), to see where a run's time goes; SC_REPRODUCIBLE=1
+/// records the times as 0 (byte-identical results); SC_HUGE_PAGES=0 keeps large
+/// blocks off huge pages; SC_MEMORY_LIMIT=8G sets the memory a factor may take.
+///
 /// Example:
 ///   sc-solve block.scmesh --setup solve.yaml -o block.scres
 ///   sc-export block.scres -o block.pvd          # then: paraview block.pvd
@@ -108,6 +114,8 @@ struct Args {
 }
 
 fn main() -> ExitCode {
+    // the origin of SC_TIMELINE=1's timeline (lib/os/timeline.rs)
+    timeline::epoch();
     let args = Args::parse();
     let rank = match ranks::participate("sc-solve", true) {
         Ok(Participation::Idle) => return ExitCode::SUCCESS,
@@ -124,10 +132,14 @@ fn main() -> ExitCode {
     };
     let code = run(args, rank);
     ranks::finish();
+    if timeline::enabled() && rank == 0 {
+        eprint!("{}", timeline::render(&timeline::entries()));
+    }
     code
 }
 
 fn run(args: Args, rank: usize) -> ExitCode {
+    let setup_span = timeline::span("read the setup");
     let mut setup = match SolveSetup::read(&args.setup) {
         Ok(s) => s,
         Err(e) => {
@@ -139,6 +151,7 @@ fn run(args: Args, rank: usize) -> ExitCode {
         let p = &mut setup.linear_solver.petsc.options;
         *p = format!("{p} {extra}").trim().to_owned();
     }
+    drop(setup_span);
     let csv = args.csv.clone().or_else(|| solve::default_csv_path(&args.output));
     let verbosity = if args.quiet { Verbosity::Quiet } else { Verbosity::Normal };
     match solve::solve(&args.input, &setup, &args.setup.display().to_string(), &args.output, csv.as_deref(), args.restart.as_deref().map(|file| solve::Restart { file, increment: args.restart_increment }), verbosity) {

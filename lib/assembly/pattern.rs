@@ -129,11 +129,25 @@ pub struct Pattern {
 impl Pattern {
     /// Builds the pattern from hexahedra and contact node groups.
     pub fn build(dofs: DofMap, hexes: &[[u32; 8]], groups: NodeGroups) -> Result<Self, PatternError> {
-        Self::build_coloured(dofs, hexes, None, groups)
+        Self::build_coloured(dofs, hexes, None, groups, |_| {})
     }
 
-    /// [`Self::build`], with the hexahedra's colouring when it is known already.
-    fn build_coloured(dofs: DofMap, hexes: &[[u32; 8]], colouring: Option<Colouring>, groups: NodeGroups) -> Result<Self, PatternError> {
+    /// [`Self::build`], handing the sparsity structure (rows of every column) to
+    /// `on_structure` as soon as it is complete, before the element slot maps are
+    /// made: the solver's symbolic analysis needs nothing more, and started there it
+    /// runs beside the rest of the set-up instead of beside the first assembly.
+    pub fn build_then(dofs: DofMap, hexes: &[[u32; 8]], groups: NodeGroups, on_structure: impl FnOnce(&Arc<SymbolicSparseColMat<usize>>)) -> Result<Self, PatternError> {
+        Self::build_coloured(dofs, hexes, None, groups, on_structure)
+    }
+
+    /// [`Self::build_then`], with the hexahedra's colouring when it is known already.
+    fn build_coloured(
+        dofs: DofMap,
+        hexes: &[[u32; 8]],
+        colouring: Option<Colouring>,
+        groups: NodeGroups,
+        on_structure: impl FnOnce(&Arc<SymbolicSparseColMat<usize>>),
+    ) -> Result<Self, PatternError> {
         let n_nodes = dofs.n_nodes();
         for (e, hex) in hexes.iter().enumerate() {
             if let Some(&node) = hex.iter().find(|&&a| a as usize >= n_nodes) {
@@ -146,6 +160,7 @@ impl Pattern {
             }
         }
 
+        let structure_span = crate::os::timeline::span("set-up: pattern structure");
         // node -> hexes and node -> groups (CSR, by counting).
         let node_hexes = invert(n_nodes, hexes.iter().map(|h| &h[..]));
         let node_groups = invert(n_nodes, groups.iter());
@@ -221,6 +236,12 @@ impl Pattern {
                 column.copy_from_slice(first);
             }
         });
+
+        let symbolic = Arc::new(SymbolicSparseColMat::new_checked(n_free, n_free, col_ptr, None, row_idx));
+        drop(structure_span);
+        on_structure(&symbolic);
+        let _slots_span = crate::os::timeline::span("set-up: element slot maps and colouring");
+        let col_ptr = symbolic.col_ptr();
 
         // Slots of an element's entries. Node blocks are stored whole, the free
         // components of one row node sit in consecutive positions of every column
@@ -305,7 +326,6 @@ impl Pattern {
         }
         outs.into_par_iter().enumerate().for_each_init(Default::default, |scratch, (g, out)| element_slots(groups.group(g), out, scratch));
 
-        let symbolic = Arc::new(SymbolicSparseColMat::new_checked(n_free, n_free, col_ptr, None, row_idx));
         let colouring = colouring.unwrap_or_else(|| Colouring::greedy(n_nodes, hexes.iter().map(|h| &h[..])));
         Ok(Self {
             dofs,
@@ -322,7 +342,7 @@ impl Pattern {
     /// The same dofs and hexahedra with new contact groups (the pattern and every
     /// slot map are rebuilt; the solver must then `analyse` again).
     pub fn with_groups(&self, groups: NodeGroups) -> Result<Self, PatternError> {
-        Self::build_coloured(self.dofs.clone(), &self.hexes, Some(self.colouring.clone()), groups)
+        Self::build_coloured(self.dofs.clone(), &self.hexes, Some(self.colouring.clone()), groups, |_| {})
     }
 
     /// The hexahedra in colours that share no node.

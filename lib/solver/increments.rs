@@ -6,6 +6,7 @@
 
 #![allow(non_snake_case)] // paper notation: X (reference coordinates)
 
+use crate::os::timeline;
 use std::path::Path;
 use std::time::Instant;
 
@@ -251,6 +252,7 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
             match outcome {
                 Ok(conv) => {
                     let t = Instant::now();
+                    let output_span = timeline::span("increment output: stresses, reactions, contact state");
                     u.copy_from_slice(&trial);
                     // stresses are output only: an MPI rank that does not write skips them
                     let stress = if !out.writer {
@@ -323,6 +325,7 @@ pub fn solve(newton: &mut Newton, factors: &[f64], max_cutbacks: u32, results: &
                         }
                     }
                     let face_pressure = face_pressures(results, &states);
+                    drop(output_span);
                     results.increments.push(Increment {
                         info: IncrementInfo { load_factor: lambda, cutbacks: cutbacks_this, iterations: conv.iterations, reactions, seconds_output: super::clock::seconds_since(t), contact: summaries },
                         u: u.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
@@ -403,6 +406,7 @@ struct WrittenCsvs {
 /// Bring the results file up to date (append what converged since) and rewrite the
 /// two CSV histories where they changed.
 fn write(file: &mut ResultsFile, written: &mut WrittenCsvs, results: &Results, out: &Outputs, log: &SolveLog) -> Result<(), StageError> {
+    let _span = timeline::span("write results and histories");
     file.sync(results)?;
     if !out.writer {
         return Ok(());

@@ -1,6 +1,7 @@
 //! `sc-solve`: a mesh (`.scmesh`) and a solve setup → results (`.scres`) and a
 //! convergence-history CSV.
 
+use crate::os::timeline;
 use std::path::Path;
 use std::time::Instant;
 
@@ -66,20 +67,30 @@ pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, 
     }
     let start = Instant::now();
     crate::solver::linear::dense_kernels::warm_in_background();
+    let read_span = timeline::span("read the model");
     let (mut mesh, pairs) = read_model(input)?;
+    drop(read_span);
     // A restart file of another model is named before the setup is checked against
     // this one; with `adjust` the file holds the adjusted coordinates, so it is
     // compared with them, once the problem has moved the nodes.
     let adjusts = setup.contact.iter().any(|c| c.adjust.is_some_and(|d| d != 0.0));
     let mut point = if adjusts { None } else { restart.map(|r| RestartPoint::read(r.file, r.increment, &mesh, &pairs)).transpose()? };
+    let problem_span = timeline::span("problem: materials, constraints, contact pairs");
     let problem = Problem::with_contact(&mesh, &pairs, setup, setup_name)?;
+    drop(problem_span);
     // the pre-solve check: a flipped master stops here; free rigid modes are warned about
     // the check and the solver's set-up (the sparsity pattern, the analysis started)
     // side by side: they read the same problem and neither needs the other; a
     // refused model drops the set-up unused
     let (check, newton) = rayon::join(
-        || crate::check::run(&mesh, &problem, &input.display().to_string(), setup_name),
-        || Newton::new(&problem, setup.newton.clone(), setup.linear_solver.clone()),
+        || {
+            let _span = timeline::span("pre-solve check");
+            crate::check::run(&mesh, &problem, &input.display().to_string(), setup_name)
+        },
+        || {
+            let _span = timeline::span("solver set-up");
+            Newton::new(&problem, setup.newton.clone(), setup.linear_solver.clone())
+        },
     );
     let check = check?;
     if let Some(e) = check.errors().into_iter().next() {

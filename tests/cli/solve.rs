@@ -336,3 +336,42 @@ fn a_model_too_large_for_memory_fails_before_factorization_with_an_estimate() {
         .unwrap();
     assert!(o.status.success(), "{}", stderr(&o));
 }
+
+/// `SC_TIMELINE=1` prints every phase of the run once it ends, each with a start
+/// no later than its end, in the order the phases started; without it nothing of
+/// the kind is printed.
+#[test]
+fn the_timeline_lists_the_phases_of_a_run_in_order() {
+    let dir = tempdir();
+    imported_cantilever(dir.path());
+    write_setup(dir.path(), GOOD);
+    let solve = |timeline: &str| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_sc-solve"))
+            .args(["c.scmesh", "--setup", "setup.yaml", "-o", "r.scres", "-q"])
+            .current_dir(dir.path())
+            .env("SC_TIMELINE", timeline)
+            .output()
+            .unwrap()
+    };
+    let o = solve("1");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    let lines: Vec<&str> = err.lines().skip_while(|l| !l.starts_with("timeline (ms since main started)")).skip(1).collect();
+    for phase in ["read the setup", "read the model", "set-up: sparsity pattern", "analysis: fill-reducing ordering", "assembly: residual and tangent", "linear solver: factor", "linear solver: solve", "write results and histories"] {
+        assert!(lines.iter().any(|l| l.ends_with(phase)), "no '{phase}' in the timeline:\n{err}");
+    }
+    let mut last_start = 0.0;
+    for l in &lines {
+        let f: Vec<f64> = l.split_whitespace().take(3).map(|v| v.parse().unwrap_or_else(|_| panic!("not a number in '{l}'"))).collect();
+        let (start, end, length) = (f[0], f[1], f[2]);
+        assert!(start >= last_start && end >= start, "out of order: '{l}'");
+        // the printed length is end − start, each rounded to 0.01 ms
+        assert!((end - start - length).abs() <= 0.011, "'{l}'");
+        last_start = start;
+    }
+    // 5 increments of a cantilever: a factorization in each
+    assert!(lines.iter().filter(|l| l.ends_with("linear solver: factor")).count() >= 5, "{err}");
+    let o = solve("0");
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!stderr(&o).contains("timeline"), "{}", stderr(&o));
+}

@@ -5,8 +5,9 @@
 //! and `/proc/cpuinfo`): 1.3–1.5 ms on the reference machine, measured inside the
 //! first factorization of the smallest Parisch level (97 unknowns; its second
 //! factorization takes 12 µs). [`warm_in_background`] makes that call once per
-//! process on a thread beside the reading of the model, so the first
-//! factorization finds the sizes known.
+//! process on a thread beside the reading of the model, on each worker of rayon's
+//! pool, so the first factorization finds the sizes known and each worker's
+//! packing buffers touched.
 
 use std::sync::Once;
 
@@ -23,14 +24,26 @@ pub fn warm_in_background() {
     });
 }
 
-/// One product in each precision the factorizations use, above the size that
-/// faer computes by its own small kernels (16³ multiply-adds).
+/// On every worker of rayon's pool (which this starts: its threads are up before
+/// the first `rayon::join` needs them, about 1.4 ms at the Parisch r = 4), one
+/// product in each precision the factorizations use, of the size of a supernode's
+/// update: the first call reads the cache sizes, and each worker's first products
+/// touch the pages of its own packing buffers, which the first factorization
+/// otherwise pays for (13 % of its time at the Parisch r = 4, medians of 25 runs:
+/// docs/performance.md).
 fn warm() {
-    const N: usize = 17;
-    let a = Mat::<f32>::from_fn(N, N, |i, j| (i + j) as f32);
-    let mut c = Mat::<f32>::zeros(N, N);
-    matmul(c.as_mut(), Accum::Replace, a.as_ref(), a.as_ref(), 1.0, Par::Seq);
-    let a = Mat::<f64>::from_fn(N, N, |i, j| (i + j) as f64);
-    let mut c = Mat::<f64>::zeros(N, N);
-    matmul(c.as_mut(), Accum::Replace, a.as_ref(), a.as_ref(), 1.0, Par::Seq);
+    rayon::broadcast(|_| {
+        product::<f32>(WARM_N);
+        product::<f64>(WARM_N);
+    });
+}
+
+/// The warm-up products' order: above faer's own small kernels (16³), at the
+/// width of a mid-sized supernode; 2 · 128³ multiply-adds take about 0.2 ms.
+const WARM_N: usize = 128;
+
+fn product<T: faer::traits::ComplexField + From<u8>>(n: usize) {
+    let a = Mat::<T>::from_fn(n, n, |i, j| T::from(((i + j) % 7) as u8));
+    let mut c = Mat::<T>::zeros(n, n);
+    matmul(c.as_mut(), Accum::Replace, a.as_ref(), a.as_ref(), T::from(1u8), Par::Seq);
 }

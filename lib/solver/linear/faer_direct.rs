@@ -60,6 +60,7 @@ use faer::perm::PermRef;
 use faer::{Conj, MatMut, Par, Side};
 
 use super::error::LinearSolverError;
+use crate::os::timeline;
 use super::tree_cholesky::{FactorReal, TreeCholesky};
 use crate::solver::ordering::{geometric_dissection, nested_dissection, FillOrdering};
 use super::interface::{check_values, FactorInfo, Factorization, LinearSolver, SharedPattern, SolverTimings, Symmetry};
@@ -310,6 +311,7 @@ impl FaerDirect {
                     let mut buf = MemBuffer::try_new(faer::sparse::utils::permute_self_adjoint_scratch::<usize>(n))
                         .map_err(|e| LinearSolverError::Faer(format!("{e:?}")))?;
                     let permuted;
+                    let permute_span = timeline::span("factor: permute P A Pᵀ");
                     let a_lower = match sym.perm() {
                         Some(perm) => {
                             permuted = faer::sparse::utils::permute_self_adjoint_to_unsorted(
@@ -326,6 +328,7 @@ impl FaerDirect {
                         }
                         None => a,
                     };
+                    drop(permute_span);
                     let dense_par = self.options.par.unwrap_or_else(faer::get_global_parallelism);
                     // the tasks write every block: no zeroing pass here, and the pages of a
                     // new factor are first touched in parallel (calloc'd, not written)
@@ -528,6 +531,7 @@ impl LinearSolver for FaerDirect {
 
     fn factor(&mut self, values: &[f64]) -> Result<FactorInfo, LinearSolverError> {
         self.finish_analysis()?;
+        let _span = timeline::span("factor (faer_direct)");
         let pattern = check_values(self.pattern.as_deref(), values)?;
         let start = Instant::now();
         self.numeric = Numeric::None;
@@ -813,6 +817,7 @@ fn analysis(owned: SharedPattern, symmetry: Symmetry, options: FaerDirectOptions
         .collect();
     let symbolic = match symmetry {
         Symmetry::Symmetric => {
+            let ordering_span = timeline::span("analysis: fill-reducing ordering");
             let perm = match options.ordering {
                 FillOrdering::Amd => None,
                 FillOrdering::NestedDissection => Some(nested_dissection(a)?),
@@ -823,6 +828,7 @@ fn analysis(owned: SharedPattern, symmetry: Symmetry, options: FaerDirectOptions
                     None => nested_dissection(a)?,
                 }),
             };
+            drop(ordering_span);
             let ordering = match &perm {
                 None => SymmetricOrdering::Amd,
                 Some(p) => SymmetricOrdering::Custom(PermRef::new_checked(&p.forward, &p.inverse, n)),
@@ -832,6 +838,7 @@ fn analysis(owned: SharedPattern, symmetry: Symmetry, options: FaerDirectOptions
             // slab (4.5k unknowns), where the supernodal one (each node's 3 dofs a dense
             // block at least) factors in half the time (docs/performance.md).
             let params = CholeskySymbolicParams { supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL, ..Default::default() };
+            let _symbolic_span = timeline::span("analysis: symbolic factorization (faer)");
             let c = factorize_symbolic_cholesky(a, Side::Lower, ordering, params).map_err(|e| LinearSolverError::Faer(format!("{e:?}")))?;
             // sized in double even for a single-precision factor: one that f32 cannot
             // hold is made in double
@@ -840,6 +847,7 @@ fn analysis(owned: SharedPattern, symmetry: Symmetry, options: FaerDirectOptions
         }
         Symmetry::General => Symbolic::Lu(factorize_symbolic_lu(a, Default::default()).map_err(|e| LinearSolverError::Faer(format!("{e:?}")))?),
     };
+    let _tree_span = timeline::span("analysis: elimination-tree tasks");
     let tree = match &symbolic {
         Symbolic::Cholesky(c) if options.elimination_tree => match c.raw() {
             SymbolicCholeskyRaw::Supernodal(s) => Some(TreeCholesky::new(s)),

@@ -12,6 +12,7 @@
 //! Newton's forcing term sets an iterative solve's tolerance), limit the step and
 //! update u.
 
+use crate::os::timeline;
 use std::time::Instant;
 
 use super::cycles::ContactCycles;
@@ -184,10 +185,15 @@ impl Newton<'_> {
             // the first analysis, if it still runs (`Newton::new` started it in the
             // background; nothing to wait for after it): its failure (a factor too
             // large for the memory) is the setup's
-            self.linear.finish_analysis().map_err(|error| IncrementFailure::Setup { error })?;
+            {
+                let _wait = timeline::span("waiting for the first analysis");
+                self.linear.finish_analysis().map_err(|error| IncrementFailure::Setup { error })?;
+            }
             let t = Instant::now();
+            let factor_span = timeline::span("linear solver: factor");
             self.linear.set_configuration(&self.problem.X, u);
             self.linear.factor(self.assembly.values()).map_err(|error| IncrementFailure::Linear { iteration, error })?;
+            drop(factor_span);
             row.seconds_factor = clock::seconds_since(t);
             if let Some(forcing) = &mut self.forcing {
                 self.linear.set_forcing(forcing.next(residual));
@@ -195,7 +201,9 @@ impl Newton<'_> {
             let t = Instant::now();
             // K_ff Δu_f = −R_f; Δu is kept in r_free for the next energy norm.
             self.r_free.iter_mut().zip(&self.rhs).for_each(|(du, r)| *du = -r);
+            let solve_span = timeline::span("linear solver: solve");
             self.linear.solve_in_place(&mut self.r_free).map_err(|error| IncrementFailure::Linear { iteration, error })?;
+            drop(solve_span);
             row.seconds_solve = clock::seconds_since(t);
             let report = self.linear.last_solve();
             row.krylov_iterations = report.krylov_iterations as u32;

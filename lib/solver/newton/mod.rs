@@ -39,6 +39,7 @@ mod stresses;
 pub use failure::{IncrementFailure, SetupFailure};
 pub use stresses::gauss_stresses;
 
+use crate::os::timeline;
 use super::forcing::Forcing;
 use super::free_bodies::{FreeBody, FreeBodyDamping};
 use super::problem::Problem;
@@ -180,8 +181,6 @@ impl<'p> Newton<'p> {
             pair.init_history();
         }
         let hexes = partition.as_ref().map_or(&problem.hexes[..], |part| &part.hexes[..]);
-        let pattern = Pattern::build(problem.dofs.clone(), hexes, groups)?;
-        let assembly = Assembly::new(&pattern)?;
         if !problem.symmetric() && matches!(choice, LinearSolverChoice::Cholesky | LinearSolverChoice::Ldlt) {
             let why = if problem.pressure_faces.is_empty() { "friction" } else { "follower pressure" };
             return Err(SetupFailure::NotSymmetric(if choice == LinearSolverChoice::Cholesky { "cholesky" } else { "ldlt" }, why));
@@ -240,9 +239,17 @@ impl<'p> Newton<'p> {
             }).collect();
             linear.set_unknown_coordinates(unknowns);
         }
-        // the first analysis runs while the first tangent is assembled; the first
-        // factorization waits for it (`solve_increment`)
-        linear.analyse_in_background(pattern.shared(), symmetry)?;
+        // the first analysis starts as soon as the pattern's structure is known and
+        // runs beside the element slot maps, the assembly workspace and the first
+        // tangent's assembly; the first factorization waits for it (`solve_increment`)
+        let pattern_span = timeline::span("set-up: sparsity pattern");
+        let mut analysis = Ok(());
+        let pattern = Pattern::build_then(problem.dofs.clone(), hexes, groups, |structure| analysis = linear.analyse_in_background(structure, symmetry))?;
+        drop(pattern_span);
+        analysis?;
+        let workspace_span = timeline::span("set-up: assembly workspace");
+        let assembly = Assembly::new(&pattern)?;
+        drop(workspace_span);
         let n = DOFS_PER_NODE * problem.n_nodes();
         let n_free = pattern.n_free();
         let stabilization = Stabilization::new(problem, &contact);

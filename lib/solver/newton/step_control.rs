@@ -11,6 +11,7 @@
 //! (docs/theory/robustness.md, "Line search and step control" and "Penetration step
 //! limit".)
 
+use crate::os::timeline;
 use std::time::Instant;
 
 use nalgebra::Vector3;
@@ -46,10 +47,15 @@ impl Newton<'_> {
         let mut halvings = 0;
         let r_norm = loop {
             let t = Instant::now();
-            self.contact_search(u, iteration)?;
+            {
+                let _span = timeline::span("contact search");
+                self.contact_search(u, iteration)?;
+            }
             seconds_contact += clock::seconds_since(t);
             let t = Instant::now();
+            let assembly_span = timeline::span(if tangent { "assembly: residual and tangent" } else { "assembly: residual" });
             let assembled = self.assemble(u, lambda, tangent);
+            drop(assembly_span);
             seconds_assembly += clock::seconds_since(t);
             match assembled {
                 Ok(()) => {
