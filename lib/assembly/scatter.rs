@@ -291,13 +291,12 @@ impl Assembly {
                     if let Err(error) = element(e, r, &mut k) {
                         return Some((e, error));
                     }
-                    for (&slot, &v) in pattern.hex_slots(e).iter().zip(k.as_slice()) {
-                        if slot != NO_SLOT {
-                            // SAFETY: the elements of one colour share no node, hence
-                            // no row: no other thread touches this entry
-                            unsafe { *values.get(slot as usize) += v };
-                        }
-                    }
+                    let k = k.as_slice();
+                    pattern.scatter_hex(e, |i, slot| {
+                        // SAFETY: the elements of one colour share no node, hence
+                        // no row: no other thread touches this entry
+                        unsafe { *values.get(slot) += k[i] };
+                    });
                     None
                 })
                 .min_by_key(|(e, _)| *e);
