@@ -61,7 +61,7 @@ use faer::{Conj, MatMut, Par, Side};
 
 use super::error::LinearSolverError;
 use crate::os::timeline;
-use super::tree_cholesky::{FactorReal, TreeCholesky};
+use super::tree_cholesky::{FactorReal, FillPermutation, TreeCholesky};
 use crate::solver::ordering::{geometric_dissection, nested_dissection, FillOrdering};
 use super::interface::{check_values, FactorInfo, Factorization, LinearSolver, SharedPattern, SolverTimings, Symmetry};
 
@@ -174,9 +174,6 @@ pub struct FaerDirect {
     /// The elimination-tree schedule of the supernodal `LLᵀ` (set by `analyse`
     /// when [`FaerDirectOptions::elimination_tree`]).
     tree: Option<TreeCholesky>,
-    /// Entries of the pattern's lower triangle, diagonal included (set by
-    /// `analyse`): the size of the permuted copy the tree factorization reads.
-    lower_nnz: usize,
     /// An analysis still running beside the caller
     /// ([`LinearSolver::analyse_in_background`]); waited for by `finish_analysis`
     /// or the next `factor`.
@@ -214,7 +211,6 @@ impl FaerDirect {
             l_values32: Vec::new(),
             widest_supernode: 0,
             tree: None,
-            lower_nnz: 0,
             pending: None,
             coordinates: None,
             largest_factor: 0,
@@ -303,32 +299,12 @@ impl FaerDirect {
         if strategy != SymmetricStrategy::Ldlt {
             let llt = match tree {
                 Some((tree, s)) => {
-                    // the lower triangle of P A Pᵀ, as faer's own numeric factorization makes it
-                    let (n, nnz_lower) = (sym.nrows(), self.lower_nnz);
-                    let mut new_val = vec![0.0; nnz_lower];
-                    let mut new_col_ptr = vec![0usize; n + 1];
-                    let mut new_row_idx = vec![0usize; nnz_lower];
-                    let mut buf = MemBuffer::try_new(faer::sparse::utils::permute_self_adjoint_scratch::<usize>(n))
-                        .map_err(|e| LinearSolverError::Faer(format!("{e:?}")))?;
-                    let permuted;
-                    let permute_span = timeline::span("factor: permute P A Pᵀ");
-                    let a_lower = match sym.perm() {
-                        Some(perm) => {
-                            permuted = faer::sparse::utils::permute_self_adjoint_to_unsorted(
-                                &mut new_val,
-                                &mut new_col_ptr,
-                                &mut new_row_idx,
-                                a,
-                                perm,
-                                Side::Lower,
-                                Side::Lower,
-                                MemStack::new(&mut buf),
-                            );
-                            faer::reborrow::Reborrow::rb(&permuted)
-                        }
-                        None => a,
-                    };
-                    drop(permute_span);
+                    // A itself, read through P: the tree factorization takes the
+                    // entries on or below the diagonal of P A Pᵀ (no permuted copy)
+                    let perm = sym.perm().map(|p| {
+                        let (forward, inverse) = p.arrays();
+                        FillPermutation { forward, inverse }
+                    });
                     let dense_par = self.options.par.unwrap_or_else(faer::get_global_parallelism);
                     // the tasks write every block: no zeroing pass here, and the pages of a
                     // new factor are first touched in parallel (calloc'd, not written)
@@ -338,7 +314,7 @@ impl FaerDirect {
                         if self.l_values32.len() != sym.len_val() {
                             self.l_values32 = vec![0.0; sym.len_val()];
                         }
-                        let factored = tree.factor_scaled(s, a_lower, scale, &mut self.l_values32, dense_par).is_ok();
+                        let factored = tree.factor_scaled(s, a, perm, scale, &mut self.l_values32, dense_par).is_ok();
                         if factored && single_pivots_hold(sym, &self.l_values32, values, &self.diag_pos, scale, orig) {
                             return Ok(Numeric::LltSingle { scale });
                         }
@@ -347,7 +323,7 @@ impl FaerDirect {
                     if self.l_values.len() != sym.len_val() {
                         self.l_values = vec![0.0; sym.len_val()];
                     }
-                    tree.factor(s, a_lower, &mut self.l_values, dense_par)
+                    tree.factor(s, a, perm, &mut self.l_values, dense_par)
                 }
                 None => {
                     self.l_values32 = Vec::new();
@@ -621,7 +597,6 @@ impl FaerDirect {
         self.l_values32 = Vec::new();
         self.widest_supernode = 0;
         self.tree = None;
-        self.lower_nnz = 0;
     }
 
     /// The analysed pattern, if any.
@@ -754,7 +729,6 @@ struct Analysis {
     diag_pos: Vec<usize>,
     symbolic: Symbolic,
     tree: Option<TreeCholesky>,
-    lower_nnz: usize,
     widest_supernode: usize,
     time: Duration,
 }
@@ -788,7 +762,6 @@ impl FaerDirect {
         self.symbolic = Some(a.symbolic);
         self.largest_factor = self.largest_factor.max(self.factor_len());
         self.tree = a.tree;
-        self.lower_nnz = a.lower_nnz;
         self.widest_supernode = a.widest_supernode;
         self.symbolic_time += a.time;
         self.n_symbolic += 1;
@@ -855,13 +828,6 @@ fn analysis(owned: SharedPattern, symmetry: Symmetry, options: FaerDirectOptions
         },
         _ => None,
     };
-    let lower_nnz = match tree {
-        Some(_) => {
-            let (cp, ri) = (owned.col_ptr(), owned.row_idx());
-            (0..n).map(|j| ri[cp[j]..cp[j + 1]].iter().filter(|&&i| i >= j).count()).sum()
-        }
-        None => 0,
-    };
     let widest_supernode = match &symbolic {
         Symbolic::Cholesky(c) => match c.raw() {
             SymbolicCholeskyRaw::Supernodal(s) => s.supernode_begin().iter().zip(s.supernode_end()).map(|(b, e)| e - b).max().unwrap_or(0),
@@ -869,7 +835,7 @@ fn analysis(owned: SharedPattern, symmetry: Symmetry, options: FaerDirectOptions
         },
         Symbolic::Lu(_) => 0,
     };
-    Ok(Analysis { pattern: owned, diag_pos, symbolic, tree, lower_nnz, widest_supernode, time: start.elapsed() })
+    Ok(Analysis { pattern: owned, diag_pos, symbolic, tree, widest_supernode, time: start.elapsed() })
 }
 
 #[cfg(test)]

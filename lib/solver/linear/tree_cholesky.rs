@@ -15,7 +15,9 @@
 //! factorization and into faer's value layout (each supernode `s` a dense
 //! column-major block of its rows × its columns), so faer's triangular solves use
 //! the factor unchanged. For supernode `s` with columns `[s₀, s₁)`:
-//! 1. scatter the lower triangle of `P A Pᵀ`'s columns `[s₀, s₁)` into `L_s`;
+//! 1. scatter the lower triangle of `P A Pᵀ`'s columns `[s₀, s₁)` into `L_s`, read
+//!    from `A` itself (column `p(j)` of `A`, its rows renumbered by `p⁻¹`; no permuted
+//!    copy is made);
 //! 2. for every descendant `d` whose row pattern meets `[s₀, s₁)` (in increasing
 //!    order of `d`), with `L_d,mid` its rows in `[s₀, s₁)` and `L_d,low` its rows
 //!    from `s₀` on: `W = L_d,low L_d,midᵀ` (dense, into a buffer, by panels of
@@ -282,11 +284,12 @@ impl TreeCholesky {
     pub fn factor(
         &self,
         symbolic: &SymbolicSupernodalCholesky<usize>,
-        a_lower: SparseColMatRef<'_, usize, f64>,
+        a: SparseColMatRef<'_, usize, f64>,
+        perm: Option<FillPermutation<'_>>,
         l_values: &mut [f64],
         par: Par,
     ) -> Result<(), LltError> {
-        self.factor_scaled(symbolic, a_lower, 1.0, l_values, par)
+        self.factor_scaled(symbolic, a, perm, 1.0, l_values, par)
     }
 
     /// [`Self::factor`] of `scale · a_lower` into a factor of any [`FactorReal`]
@@ -294,16 +297,20 @@ impl TreeCholesky {
     pub fn factor_scaled<T: FactorReal>(
         &self,
         symbolic: &SymbolicSupernodalCholesky<usize>,
-        a_lower: SparseColMatRef<'_, usize, f64>,
+        a: SparseColMatRef<'_, usize, f64>,
+        perm: Option<FillPermutation<'_>>,
         scale: f64,
         l_values: &mut [T],
         par: Par,
     ) -> Result<(), LltError> {
         assert_eq!(l_values.len(), symbolic.len_val(), "the value array must match the symbolic factor");
-        assert_eq!(a_lower.nrows(), symbolic.nrows(), "the matrix must match the symbolic factor");
+        assert_eq!(a.nrows(), symbolic.nrows(), "the matrix must match the symbolic factor");
+        if let Some(p) = &perm {
+            assert!(p.forward.len() == a.nrows() && p.inverse.len() == a.nrows(), "the permutation must match the matrix");
+        }
         let values = SharedValues { ptr: l_values.as_mut_ptr(), len: l_values.len() };
         let failed = std::sync::Mutex::new(None::<usize>);
-        let ctx = Context { tree: self, symbolic, a_lower, scale, values, failed: &failed, par, w_entries: W_ENTRIES.max(l_values.len() / 64) };
+        let ctx = Context { tree: self, symbolic, a, perm, scale, values, failed: &failed, par, w_entries: W_ENTRIES.max(l_values.len() / 64) };
         let threads = rayon::current_num_threads();
         if threads <= 1 {
             for s in 0..symbolic.n_supernodes() {
@@ -324,11 +331,21 @@ impl TreeCholesky {
     }
 }
 
+/// The fill-reducing permutation `P` of a factorization: `forward[j]` the column of
+/// `A` that is column `j` of `P A Pᵀ`, `inverse` its inverse.
+#[derive(Clone, Copy, Debug)]
+pub struct FillPermutation<'a> {
+    pub forward: &'a [usize],
+    pub inverse: &'a [usize],
+}
+
 /// What every task of one factorization shares.
 struct Context<'a, T> {
     tree: &'a TreeCholesky,
     symbolic: &'a SymbolicSupernodalCholesky<usize>,
-    a_lower: SparseColMatRef<'a, usize, f64>,
+    /// `A` (its entries on or below the diagonal of `P A Pᵀ` are read).
+    a: SparseColMatRef<'a, usize, f64>,
+    perm: Option<FillPermutation<'a>>,
     /// Factor of the matrix's entries (see [`TreeCholesky::factor_scaled`]).
     scale: f64,
     values: SharedValues<T>,
@@ -394,10 +411,13 @@ impl<T: FactorReal> Context<'_, T> {
             for (i, &r) in s_pattern.iter().enumerate() {
                 local[r] = s_ncols + i;
             }
-            // 1. the matrix's own entries
+            // 1. the matrix's own entries: column j of P A Pᵀ is column p(j) of A,
+            // its row i' at p⁻¹(i')
             for j in s0..s1 {
                 let col = j - s0;
-                for (i, &v) in self.a_lower.row_idx_of_col(j).zip(self.a_lower.val_of_col(j)) {
+                let c = self.perm.as_ref().map_or(j, |p| p.forward[j]);
+                for (i, &v) in self.a.row_idx_of_col(c).zip(self.a.val_of_col(c)) {
+                    let i = self.perm.as_ref().map_or(i, |p| p.inverse[i]);
                     if i < j {
                         continue;
                     }
@@ -519,6 +539,8 @@ pub(super) mod tests {
         pub(in crate::solver::linear) v: Vec<f64>,
         pub(in crate::solver::linear) sym: SymbolicCholesky<usize>,
         lower: (Vec<usize>, Vec<usize>, Vec<f64>),
+        /// Factor faer's permuted lower triangle instead of `A` through `P`.
+        from_permuted_copy: bool,
     }
 
     impl Problem {
@@ -537,7 +559,7 @@ pub(super) mod tests {
             let used = cp[n];
             ri.truncate(used);
             val.truncate(used);
-            Self { p, v, sym, lower: (cp, ri, val) }
+            Self { p, v, sym, lower: (cp, ri, val), from_permuted_copy: false }
         }
 
         pub(in crate::solver::linear) fn supernodal(&self) -> &SymbolicSupernodalCholesky<usize> {
@@ -556,12 +578,20 @@ pub(super) mod tests {
         /// rayon threads.
         pub(in crate::solver::linear) fn tree_factor_scaled<T: FactorReal>(&self, threads: usize, par: Par, scale: f64) -> Result<Vec<T>, LltError> {
             let s = self.supernodal();
-            let (cp, ri, val) = &self.lower;
-            let n = self.p.nrows();
-            let a_lower = SparseColMatRef::new(SymbolicSparseColMatRef::new_unsorted_checked(n, n, cp, None, ri), val);
             let mut l = vec![T::of_f64(0.0); s.len_val()];
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("a thread pool");
-            pool.install(|| TreeCholesky::new(s).factor_scaled(s, a_lower, scale, &mut l, par))?;
+            let tree = TreeCholesky::new(s);
+            if self.from_permuted_copy {
+                // the lower triangle of P A Pᵀ made by faer, identity permutation
+                let (cp, ri, val) = &self.lower;
+                let n = self.p.nrows();
+                let a_lower = SparseColMatRef::new(SymbolicSparseColMatRef::new_unsorted_checked(n, n, cp, None, ri), val);
+                pool.install(|| tree.factor_scaled(s, a_lower, None, scale, &mut l, par))?;
+            } else {
+                let a = SparseColMatRef::new(self.p.as_ref(), &self.v);
+                let (forward, inverse) = self.sym.perm().expect("a fill-reducing permutation").arrays();
+                pool.install(|| tree.factor_scaled(s, a, Some(FillPermutation { forward, inverse }), scale, &mut l, par))?;
+            }
             Ok(l)
         }
 
@@ -613,6 +643,19 @@ pub(super) mod tests {
         let x = solve(FaerDirectOptions::default(), &pb.p, &pb.v, &b).unwrap();
         let r = relative_residual(pb.p.col_ptr(), pb.p.row_idx(), &pb.v, &x, &b);
         assert!(r < 1e-12, "residual {r:e}");
+    }
+
+    /// Read from `A` through `P` (both triangles stored, the entries on or below
+    /// the diagonal of `P A Pᵀ` taken), the factor is the one of faer's permuted
+    /// lower triangle bit for bit: the elastic cube's matrix is symmetric bit for
+    /// bit, so the entries taken from A's upper triangle equal the lower ones.
+    #[test]
+    fn the_factor_read_through_the_permutation_is_that_of_the_permuted_copy() {
+        let mut pb = cube(8);
+        let through = pb.tree_factor(2, Par::Seq).unwrap();
+        pb.from_permuted_copy = true;
+        let copy = pb.tree_factor(2, Par::Seq).unwrap();
+        assert!(through == copy, "the two factors differ");
     }
 
     #[test]
