@@ -273,8 +273,11 @@ impl TreeCholesky {
         tops + (0..self.children.len()).filter(|&s| split(s)).map(|s| self.children[s].len()).sum::<usize>()
     }
 
-    /// Numeric `LLᵀ` of `a_lower` (the lower triangle of `P A Pᵀ`, in the
-    /// symbolic factor's order; row indices within a column in any order) into
+    /// Numeric `LLᵀ` of `P A Pᵀ` (`P` the symbolic factor's permutation `perm`,
+    /// `None` for the identity) into `l_values`: `a` is read through `perm`, and its
+    /// entries that land on or below the diagonal of `P A Pᵀ` are taken (both
+    /// triangles of `A` may be stored, or only those entries; row indices within a
+    /// column in any order). The values go to
     /// `l_values` (faer's supernodal layout, `symbolic.len_val()` values). `par`
     /// is given to the dense kernels of the wide supernodes at the top of the tree
     /// (see [`DENSE_PARALLEL_COLUMNS`]); the subtrees run on rayon's pool.
@@ -292,7 +295,7 @@ impl TreeCholesky {
         self.factor_scaled(symbolic, a, perm, 1.0, l_values, par)
     }
 
-    /// [`Self::factor`] of `scale · a_lower` into a factor of any [`FactorReal`]
+    /// [`Self::factor`] of `scale · A` into a factor of any [`FactorReal`]
     /// (each entry `scale · a_ij` rounded once).
     pub fn factor_scaled<T: FactorReal>(
         &self,
