@@ -53,9 +53,7 @@ fn main() -> ExitCode {
     // warnings are said even when quiet
     let mut warn = |line: &str| eprintln!("warning: {line}");
     let outcome = splinecontact::pipeline::run(&args.pipeline, verbosity, &mut log, &mut warn);
-    if splinecontact::os::timeline::enabled() {
-        eprint!("{}", splinecontact::os::timeline::render(&splinecontact::os::timeline::entries()));
-    }
+    splinecontact::os::timeline::report();
     match outcome {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

@@ -132,8 +132,8 @@ fn main() -> ExitCode {
     };
     let code = run(args, rank);
     ranks::finish();
-    if timeline::enabled() && rank == 0 {
-        eprint!("{}", timeline::render(&timeline::entries()));
+    if rank == 0 {
+        timeline::report();
     }
     code
 }

@@ -78,6 +78,14 @@ pub fn entries() -> Vec<Entry> {
     v
 }
 
+/// Print the timeline to standard error when [`enabled`] (what a binary does at
+/// its end).
+pub fn report() {
+    if enabled() {
+        eprint!("{}", render(&entries()));
+    }
+}
+
 /// The timeline as text: a header, then `start end duration thread name` a line (ms).
 pub fn render(entries: &[Entry]) -> String {
     let mut s = String::from("timeline (ms since main started):    start      end   length  thread            phase\n");

@@ -353,7 +353,9 @@ fn the_timeline_lists_the_phases_of_a_run_in_order() {
             .output()
             .unwrap()
     };
+    let t = std::time::Instant::now();
     let o = solve("1");
+    let wall_ms = 1e3 * t.elapsed().as_secs_f64();
     assert!(o.status.success(), "{}", stderr(&o));
     let err = stderr(&o);
     let lines: Vec<&str> = err.lines().skip_while(|l| !l.starts_with("timeline (ms since main started)")).skip(1).collect();
@@ -371,6 +373,16 @@ fn the_timeline_lists_the_phases_of_a_run_in_order() {
     }
     // 5 increments of a cantilever: a factorization in each
     assert!(lines.iter().filter(|l| l.ends_with("linear solver: factor")).count() >= 5, "{err}");
+    // the clock is one for every thread: the first factorization starts after the
+    // first tangent it factors is assembled, and nothing ends after the process did
+    let span = |phase: &str| -> (f64, f64) {
+        let l = lines.iter().find(|l| l.ends_with(phase)).unwrap();
+        let f: Vec<f64> = l.split_whitespace().take(2).map(|v| v.parse().unwrap()).collect();
+        (f[0], f[1])
+    };
+    assert!(span("linear solver: factor").0 >= span("assembly: residual and tangent").1, "{err}");
+    let last_end = lines.iter().map(|l| l.split_whitespace().nth(1).unwrap().parse::<f64>().unwrap()).fold(0.0, f64::max);
+    assert!(last_end > 0.0 && last_end <= wall_ms, "the timeline ends at {last_end} ms, the process took {wall_ms} ms");
     let o = solve("0");
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(!stderr(&o).contains("timeline"), "{}", stderr(&o));
