@@ -82,16 +82,19 @@ pub fn solve(input: &Path, setup: &SolveSetup, setup_name: &str, output: &Path, 
     // the check and the solver's set-up (the sparsity pattern, the analysis started)
     // side by side: they read the same problem and neither needs the other; a
     // refused model drops the set-up unused
-    let (check, newton) = rayon::join(
-        || {
+    let (check, newton) = std::thread::scope(|scope| {
+        let check = scope.spawn(|| {
             let _span = timeline::span("pre-solve check");
             crate::check::run(&mesh, &problem, &input.display().to_string(), setup_name)
-        },
-        || {
+        });
+        let newton = {
             let _span = timeline::span("solver set-up");
             Newton::new(&problem, setup.newton.clone(), setup.linear_solver.clone())
-        },
-    );
+        };
+        (check.join(), newton)
+    });
+    // a panic of the check is the process's, as it would be on this thread
+    let check = check.unwrap_or_else(|panic| std::panic::resume_unwind(panic));
     let check = check?;
     if let Some(e) = check.errors().into_iter().next() {
         return Err(e.into());
