@@ -144,7 +144,7 @@ pub fn elastic_cube(n: usize, solver: &mut dyn LinearSolver, symmetry: Symmetry)
     solver.analyse(p.symbolic(), symmetry)?;
     let info = solver.factor(values)?;
     let mut x = cube.rhs.clone();
-    solver.solve_in_place(&mut x)?;
+    solver.solve_in_place(values, &mut x)?;
     let after = solver.timings();
     Ok(BenchTimings {
         elements_per_edge: n,

@@ -102,7 +102,8 @@ pub struct SymmetricPartGmres {
     transpose: Vec<u32>,
     /// `Kᵀ` in the pattern's CSC order, that is `K` by rows (the only copy of `K`
     /// kept: `K[p] = values_t[transpose[p]]`); `K` itself when the pattern is not
-    /// structurally symmetric or `K` is symmetric.
+    /// structurally symmetric. Empty for a symmetric `K`: its rows are its columns,
+    /// and its solves read the caller's values (`solve_in_place`).
     values_t: Vec<f64>,
     /// Scratch: `S` for its factorization, or `K` for the LU fallback.
     s_values: Vec<f64>,
@@ -190,14 +191,14 @@ impl SymmetricPartGmres {
         }
     }
 
-    /// GMRES on the stored `K` with the held factorization of `S`, right-hand side
-    /// `self.rhs`, solution into `x`.
-    fn run_gmres(&mut self, x: &mut [f64], settings: GmresSettings) -> Result<super::gmres::GmresOutcome, String> {
+    /// GMRES on `K` (given by rows: `values_t`, or a symmetric `K`'s own values)
+    /// with the held factorization of `S`, right-hand side `self.rhs`, solution
+    /// into `x`.
+    fn run_gmres(&self, values_t: &[f64], x: &mut [f64], settings: GmresSettings) -> Result<super::gmres::GmresOutcome, String> {
         let symmetric = &self.symmetric;
         let pattern = symmetric.pattern().ok_or("no pattern")?;
         let n = pattern.nrows();
         let (cp, ri) = (pattern.col_ptr(), pattern.row_idx());
-        let values_t = &self.values_t;
         // (K x)_i = Σ_j K_ij x_j: row i of K is column i of Kᵀ (structural symmetry).
         let mut apply = |x: &[f64], out: &mut [f64]| {
             out.par_iter_mut().enumerate().with_min_len(256).for_each(|(i, o)| {
@@ -273,30 +274,19 @@ impl SymmetricPartGmres {
 }
 
 impl SymmetricPartGmres {
-    /// `factor` of a symmetric tangent: keep the held factorization (and copy `K`
-    /// for GMRES) while the last solve needed at most `reuse_below` iterations,
-    /// else factor `K` itself (no copy: a fresh factorization solves directly). A
-    /// tangent that cannot be factored is reported (a singular one with its dof),
-    /// as the direct solver does.
+    /// `factor` of a symmetric tangent: keep the held factorization while the last
+    /// solve needed at most `reuse_below` iterations, else factor `K` itself. No
+    /// copy of `K` either way: GMRES (with a kept or a single-precision factor)
+    /// applies the values the solve is given. A tangent that cannot be factored
+    /// is reported (a singular one with its dof), as the direct solver does.
     fn factor_symmetric_tangent(&mut self, values: &[f64]) -> Result<Factorization, LinearSolverError> {
         match self.held {
             Some(method) if self.last_iterations <= self.reuse_below => {
-                self.values_t.clear();
-                self.values_t.extend_from_slice(values);
                 self.fresh = false;
                 self.n_reused += 1;
                 Ok(method)
             }
-            _ => {
-                // the copy of an earlier K goes before the factorization (peak memory)
-                self.values_t = Vec::new();
-                let method = self.factor_and_hold(values, false)?;
-                if !self.symmetric.solves_exactly() {
-                    // GMRES makes a single-precision factor's solves exact: it needs K
-                    self.values_t.extend_from_slice(values);
-                }
-                Ok(method)
-            }
+            _ => self.factor_and_hold(values, false),
         }
     }
 
@@ -318,11 +308,11 @@ impl SymmetricPartGmres {
     /// misses its budget is factored anew and the solve repeated; a
     /// single-precision one that misses, in double precision, which solves
     /// directly.
-    fn solve_symmetric_tangent(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolverError> {
+    fn solve_symmetric_tangent(&mut self, values: &[f64], rhs: &mut [f64]) -> Result<(), LinearSolverError> {
         if self.fresh && self.symmetric.solves_exactly() {
             self.last_iterations = 0;
             self.last = SolveReport::default();
-            return self.symmetric.solve_in_place(rhs);
+            return self.symmetric.solve(rhs);
         }
         self.rhs.clear();
         self.rhs.extend_from_slice(rhs);
@@ -335,23 +325,21 @@ impl SymmetricPartGmres {
         // single in a trial: exact to 1.9e-8 instead of 1e-11)
         let settings = if self.fresh { self.fresh_single_settings() } else { self.kept_symmetric_settings(b_norm) };
         let mut iterations = 0;
-        let mut converged = self.gmres_converged(rhs, settings, &mut iterations);
+        let mut converged = self.gmres_converged(values, rhs, settings, &mut iterations);
         let mut result = Ok(());
         if !converged && !self.fresh {
             // the tangent moved far from the kept factorization: factor it
-            result = self.refactor_and_solve(rhs, false, &mut iterations).map(|done| converged = done);
+            result = self.refactor_and_solve(values, rhs, false, &mut iterations).map(|done| converged = done);
         }
         if result.is_ok() && !converged {
             // a single-precision factor that does not make GMRES converge: double
-            result = self.refactor_and_solve(rhs, true, &mut iterations).map(|_| ());
+            result = self.refactor_and_solve(values, rhs, true, &mut iterations).map(|_| ());
         }
         self.n_krylov += iterations;
         self.last = SolveReport { krylov_iterations: iterations, fallback: None };
         if self.fresh && self.symmetric.solves_exactly() {
             self.last_iterations = 0;
         }
-        // K's copy is not needed until the next kept solve (peak memory)
-        self.values_t = Vec::new();
         result
     }
 
@@ -363,7 +351,7 @@ impl SymmetricPartGmres {
         let refactored = self.factor_symmetric(double);
         self.numeric_time += t.elapsed();
         if refactored.is_ok() {
-            *outcome = self.run_gmres(x, self.settings);
+            *outcome = self.run_gmres(&self.values_t, x, self.settings);
             *iterations += outcome.as_ref().map_or(0, |o| o.iterations);
         }
     }
@@ -374,33 +362,31 @@ impl SymmetricPartGmres {
         GmresSettings { tolerance: f64::EPSILON, max_iterations: self.settings.max_iterations.min(SINGLE_BUDGET), ..self.settings }
     }
 
-    /// GMRES on the stored `K` and right-hand side `self.rhs` into `x`; whether it
-    /// converged (its iterations added to `iterations`, and kept as the last
-    /// solve's for the decision to keep the factorization).
-    fn gmres_converged(&mut self, x: &mut [f64], settings: GmresSettings, iterations: &mut usize) -> bool {
-        let outcome = self.run_gmres(x, settings);
+    /// GMRES on the symmetric `K` of `values` and right-hand side `self.rhs` into
+    /// `x`; whether it converged (its iterations added to `iterations`, and kept as
+    /// the last solve's for the decision to keep the factorization).
+    fn gmres_converged(&mut self, values: &[f64], x: &mut [f64], settings: GmresSettings, iterations: &mut usize) -> bool {
+        let outcome = self.run_gmres(values, x, settings);
         let its = outcome.as_ref().map_or(0, |o| o.iterations);
         *iterations += its;
         self.last_iterations = its;
         matches!(outcome, Ok(o) if o.converged)
     }
 
-    /// Factor the stored symmetric tangent `K` anew (in double precision when
+    /// Factor the symmetric tangent `K` of `values` anew (in double precision when
     /// `double`) and solve `K x = self.rhs` into `x`: directly when the new factor
     /// is exact, by GMRES otherwise. Whether the solve converged.
-    fn refactor_and_solve(&mut self, x: &mut [f64], double: bool, iterations: &mut usize) -> Result<bool, LinearSolverError> {
+    fn refactor_and_solve(&mut self, values: &[f64], x: &mut [f64], double: bool, iterations: &mut usize) -> Result<bool, LinearSolverError> {
         let t = Instant::now();
-        let k = std::mem::take(&mut self.values_t);
-        let refactored = self.factor_and_hold(&k, double);
-        self.values_t = k;
+        let refactored = self.factor_and_hold(values, double);
         self.numeric_time += t.elapsed();
         refactored?;
         x.copy_from_slice(&self.rhs);
         if self.symmetric.solves_exactly() {
-            self.symmetric.solve_in_place(x)?;
+            self.symmetric.solve(x)?;
             return Ok(true);
         }
-        Ok(self.gmres_converged(x, self.fresh_single_settings(), iterations))
+        Ok(self.gmres_converged(values, x, self.fresh_single_settings(), iterations))
     }
 }
 
@@ -542,32 +528,36 @@ impl LinearSolver for SymmetricPartGmres {
         self.increment_rhs = 0.0;
     }
 
-    fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolverError> {
+    fn solve_in_place(&mut self, values: &[f64], rhs: &mut [f64]) -> Result<(), LinearSolverError> {
         self.finish_analysis()?;
         let Some(pattern) = self.pattern() else {
             return Err(LinearSolverError::Order("solve_in_place", "analyse"));
         };
-        let n = pattern.nrows();
+        let (n, nnz) = (pattern.nrows(), pattern.row_idx().len());
         if rhs.len() != n {
             return Err(LinearSolverError::Dimension { what: "right-hand side entries", expected: n, got: rhs.len() });
         }
         let start = Instant::now();
         self.n_solve += 1;
         if self.symmetric_tangent {
-            let result = self.solve_symmetric_tangent(rhs);
+            // GMRES applies the symmetric K of these values (its rows are its columns)
+            if values.len() != nnz {
+                return Err(LinearSolverError::Dimension { what: "values (pattern entries)", expected: nnz, got: values.len() });
+            }
+            let result = self.solve_symmetric_tangent(values, rhs);
             self.solve_time += start.elapsed();
             return result;
         }
         if let Some(reason) = &self.lu_reason {
             self.last = SolveReport { krylov_iterations: 0, fallback: Some(format!("{reason}: solved by LU instead")) };
-            let r = self.lu.solve_in_place(rhs);
+            let r = self.lu.solve(rhs);
             self.solve_time += start.elapsed();
             return r;
         }
         self.rhs.clear();
         self.rhs.extend_from_slice(rhs);
         let settings = if self.fresh { self.settings } else { self.kept_settings() };
-        let mut outcome = self.run_gmres(rhs, settings);
+        let mut outcome = self.run_gmres(&self.values_t, rhs, settings);
         let mut iterations = outcome.as_ref().map_or(0, |o| o.iterations);
         if !matches!(outcome, Ok(o) if o.converged) && !self.fresh {
             // a held factorization of an earlier S: factor the current one and retry
@@ -601,7 +591,7 @@ impl LinearSolver for SymmetricPartGmres {
                 factored?;
                 rhs.copy_from_slice(&self.rhs);
                 self.last = SolveReport { krylov_iterations: iterations, fallback: Some(format!("{why}: solved by LU instead")) };
-                self.lu.solve_in_place(rhs)
+                self.lu.solve(rhs)
             }
         };
         self.solve_time += start.elapsed();
@@ -684,7 +674,7 @@ mod tests {
             s.analyse(p.as_ref(), Symmetry::General).unwrap();
             assert_eq!(s.factor(&v).unwrap().method, Factorization::Llt);
             let mut x = b.clone();
-            s.solve_in_place(&mut x).unwrap();
+            s.solve_in_place(&v, &mut x).unwrap();
             let r = relative_residual(p.col_ptr(), p.row_idx(), &v, &x, &b);
             let report = s.last_solve();
             assert!(r <= 1e-12 && report.fallback.is_none(), "skew {skew}: residual {r:e}, {report:?}");
@@ -693,7 +683,7 @@ mod tests {
             lu.analyse(p.as_ref(), Symmetry::General).unwrap();
             lu.factor(&v).unwrap();
             let mut y = b.clone();
-            lu.solve_in_place(&mut y).unwrap();
+            lu.solve_in_place(&v, &mut y).unwrap();
             let scale = y.iter().map(|v| v.abs()).fold(0.0, f64::max);
             let d = x.iter().zip(&y).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
             assert!(d <= 1e-9 * scale, "skew {skew}: differs from LU by {:e}", d / scale);
@@ -709,7 +699,7 @@ mod tests {
         s.analyse(p.as_ref(), Symmetry::General).unwrap();
         s.factor(&v).unwrap();
         let mut x = b.clone();
-        s.solve_in_place(&mut x).unwrap();
+        s.solve_in_place(&v, &mut x).unwrap();
         let report = s.last_solve();
         let why = report.fallback.expect("a fallback");
         assert!(why.contains("GMRES") && why.contains("1 iterations"), "{why}");
@@ -742,14 +732,14 @@ mod tests {
         s.analyse(p.as_ref(), Symmetry::General).unwrap();
         s.factor(&v).unwrap();
         let mut x = b.clone();
-        s.solve_in_place(&mut x).unwrap();
+        s.solve_in_place(&v, &mut x).unwrap();
         assert!(s.fresh && s.last_solve().fallback.is_none() && s.last_solve().krylov_iterations <= 15, "{:?}", s.last_solve());
         // a nearby tangent: the held S preconditions it; the solution is K₂'s
         let v2: Vec<f64> = v.iter().map(|a| 1.02 * a).collect();
         s.factor(&v2).unwrap();
         assert!(!s.fresh);
         let mut x = b.clone();
-        s.solve_in_place(&mut x).unwrap();
+        s.solve_in_place(&v2, &mut x).unwrap();
         assert!(residual(&p, &v2, &x, &b) <= 1e-12 && s.last_solve().fallback.is_none());
         let t = s.timings();
         assert_eq!((t.n_numeric, t.n_reused), (1, 1));
@@ -758,7 +748,7 @@ mod tests {
         let v3 = scale_diagonal(&p, &v, |j| if j % 2 == 0 { 50.0 } else { 0.6 });
         s.factor(&v3).unwrap();
         let mut x = b.clone();
-        s.solve_in_place(&mut x).unwrap();
+        s.solve_in_place(&v3, &mut x).unwrap();
         let t = s.timings();
         assert!(residual(&p, &v3, &x, &b) <= 1e-12, "{:?}", s.last_solve());
         assert_eq!((t.n_numeric, t.n_reused, t.n_fallback), (2, 2, 0), "{t:?}");
@@ -769,7 +759,7 @@ mod tests {
         for vals in [&v, &v2] {
             every.factor(vals).unwrap();
             let mut x = b.clone();
-            every.solve_in_place(&mut x).unwrap();
+            every.solve_in_place(vals, &mut x).unwrap();
         }
         assert_eq!((every.timings().n_numeric, every.timings().n_reused), (2, 0));
     }
@@ -783,17 +773,17 @@ mod tests {
         // no transpose map: K is stored once
         assert!(s.transpose.is_empty());
         // a fresh factor solves directly: the direct solver's answer, bit for bit,
-        // and no copy of K held
+        // and no copy of K held (nor ever: GMRES reads the values given to the solve)
         assert_eq!(s.factor(&v).unwrap().method, Factorization::Llt);
         assert!(s.values_t.is_empty());
         let mut x = b.clone();
-        s.solve_in_place(&mut x).unwrap();
+        s.solve_in_place(&v, &mut x).unwrap();
         assert_eq!(s.last_solve().krylov_iterations, 0, "{:?}", s.last_solve());
         let mut direct = FaerDirect::default();
         direct.analyse(p.as_ref(), Symmetry::Symmetric).unwrap();
         direct.factor(&v).unwrap();
         let mut y = b.clone();
-        direct.solve_in_place(&mut y).unwrap();
+        direct.solve_in_place(&v, &mut y).unwrap();
         assert_eq!(x, y);
         // a nearby tangent (a stiffer diagonal, as contact adds): the kept factor,
         // GMRES to the tolerance, no new factorization
@@ -801,18 +791,18 @@ mod tests {
         s.factor(&v2).unwrap();
         assert!(!s.fresh);
         let mut x = b.clone();
-        s.solve_in_place(&mut x).unwrap();
+        s.solve_in_place(&v2, &mut x).unwrap();
         let its = s.last_solve().krylov_iterations;
         assert!(residual(&p, &v2, &x, &b) <= 1e-12 && (2..=8).contains(&its), "{its} iterations");
         assert_eq!((s.timings().n_numeric, s.timings().n_reused), (1, 1));
-        // the copy of K is dropped after the kept solve
+        // the kept solve read v2 as given: no copy of K
         assert!(s.values_t.is_empty());
         // a far one: the kept factor misses its budget of 4 x 8 iterations and K is
         // factored anew (one more factorization, no LU)
         let v3 = scale_diagonal(&p, &v, |j| if j % 2 == 0 { 50.0 } else { 0.6 });
         s.factor(&v3).unwrap();
         let mut x = b.clone();
-        s.solve_in_place(&mut x).unwrap();
+        s.solve_in_place(&v3, &mut x).unwrap();
         let t = s.timings();
         assert!(residual(&p, &v3, &x, &b) <= 1e-12 && s.fresh, "{:?}", s.last_solve());
         assert_eq!((t.n_numeric, t.n_reused, t.n_fallback), (2, 2, 0), "{t:?}");
@@ -836,13 +826,13 @@ mod tests {
         s.begin_increment();
         s.factor(&v).unwrap();
         let mut x = b.clone();
-        s.solve_in_place(&mut x).unwrap();
+        s.solve_in_place(&v, &mut x).unwrap();
         let v2 = scale_diagonal(&p, &v, |j| 1.0 + 0.005 * ((j % 7) as f64) / 7.0);
         let kept_solve = |s: &mut SymmetricPartGmres, rhs: &[f64]| {
             s.factor(&v2).unwrap();
             assert!(!s.fresh, "the factor is kept");
             let mut x = rhs.to_vec();
-            s.solve_in_place(&mut x).unwrap();
+            s.solve_in_place(&v2, &mut x).unwrap();
             (residual(&p, &v2, &x, rhs), s.last_solve().krylov_iterations)
         };
         let (r_full, its_full) = kept_solve(&mut s, &b);
@@ -861,21 +851,21 @@ mod tests {
     fn a_single_precision_factor_solves_every_system_by_gmres_to_the_tolerance() {
         let single = FaerDirectOptions { precision: FactorPrecision::Single, ..Default::default() };
         // a symmetric tangent: the fresh factor preconditions, GMRES makes it exact,
-        // and K is copied for it
+        // reading K where the solve is given it (no copy)
         let (p, v, b) = skewed(0.0);
         let mut s = SymmetricPartGmres::with_reuse(GmresSettings::default(), single, 8);
         s.analyse(p.as_ref(), Symmetry::Symmetric).unwrap();
         assert_eq!(s.factor(&v).unwrap().method, Factorization::Llt);
-        assert!(!s.symmetric.solves_exactly() && s.values_t.len() == v.len());
+        assert!(!s.symmetric.solves_exactly() && s.values_t.is_empty());
         let mut x = b.clone();
-        s.solve_in_place(&mut x).unwrap();
+        s.solve_in_place(&v, &mut x).unwrap();
         let its = s.last_solve().krylov_iterations;
         assert!(residual(&p, &v, &x, &b) <= 1e-12 && (1..=8).contains(&its), "{its} iterations");
         // kept for a nearby tangent, as a double one is
         let v2 = scale_diagonal(&p, &v, |j| 1.0 + 0.005 * ((j % 7) as f64) / 7.0);
         s.factor(&v2).unwrap();
         let mut x = b.clone();
-        s.solve_in_place(&mut x).unwrap();
+        s.solve_in_place(&v2, &mut x).unwrap();
         assert!(residual(&p, &v2, &x, &b) <= 1e-12 && !s.fresh);
         assert_eq!((s.timings().n_numeric, s.timings().n_reused, s.timings().n_fallback), (1, 1, 0));
         // GMRES that cannot converge with the single factor (one iteration allowed):
@@ -884,7 +874,7 @@ mod tests {
         s.analyse(p.as_ref(), Symmetry::Symmetric).unwrap();
         s.factor(&v).unwrap();
         let mut x = b.clone();
-        s.solve_in_place(&mut x).unwrap();
+        s.solve_in_place(&v, &mut x).unwrap();
         assert!(s.symmetric.solves_exactly() && residual(&p, &v, &x, &b) <= 1e-12);
         assert_eq!(s.timings().n_numeric, 2);
         // a free chain of unit springs, each node held by 1e-9 of one (κ ≈ 4e9):
@@ -907,12 +897,12 @@ mod tests {
         s.analyse(p.as_ref(), Symmetry::Symmetric).unwrap();
         s.factor(&v).unwrap();
         let mut x = b.clone();
-        s.solve_in_place(&mut x).unwrap();
+        s.solve_in_place(&v, &mut x).unwrap();
         let mut direct = FaerDirect::default();
         direct.analyse(p.as_ref(), Symmetry::Symmetric).unwrap();
         direct.factor(&v).unwrap();
         let mut y = b.clone();
-        direct.solve_in_place(&mut y).unwrap();
+        direct.solve_in_place(&v, &mut y).unwrap();
         assert!(s.symmetric.solves_exactly() && x == y, "{:?}", s.last_solve());
         assert!(s.last_solve().krylov_iterations <= SINGLE_BUDGET);
         // a frictional tangent: S in single precision, GMRES, no LU
@@ -922,7 +912,7 @@ mod tests {
         s.factor(&v).unwrap();
         assert!(!s.symmetric.solves_exactly());
         let mut x = b.clone();
-        s.solve_in_place(&mut x).unwrap();
+        s.solve_in_place(&v, &mut x).unwrap();
         assert!(residual(&p, &v, &x, &b) <= 1e-12, "{:?}", s.last_solve());
         assert_eq!((s.timings().n_fallback, s.last_solve().fallback), (0, None));
     }
@@ -951,7 +941,7 @@ mod tests {
                 s.set_forcing(eta);
             }
             let mut x = b.clone();
-            s.solve_in_place(&mut x).unwrap();
+            s.solve_in_place(&v, &mut x).unwrap();
             (residual(&p, &v, &x, &b), s.last_solve().krylov_iterations)
         };
         let (r_tight, its_tight) = solve(None);
@@ -973,7 +963,7 @@ mod tests {
         s.analyse(p.as_ref(), Symmetry::General).unwrap();
         assert_eq!(s.factor(&v).unwrap().method, Factorization::Lu);
         let mut x = vec![1.0, 2.0];
-        s.solve_in_place(&mut x).unwrap();
+        s.solve_in_place(&v, &mut x).unwrap();
         // K x = b: x = (−2, 1)
         assert!((x[0] + 2.0).abs() < 1e-14 && (x[1] - 1.0).abs() < 1e-14, "{x:?}");
         assert!(s.last_solve().fallback.unwrap().contains("symmetric part could not be factored"));

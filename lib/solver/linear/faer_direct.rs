@@ -542,7 +542,7 @@ impl LinearSolver for FaerDirect {
         result.map(|method| FactorInfo { method, time })
     }
 
-    fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolverError> {
+    fn solve_in_place(&mut self, _values: &[f64], rhs: &mut [f64]) -> Result<(), LinearSolverError> {
         self.solve(rhs)
     }
 

@@ -96,8 +96,11 @@ pub trait LinearSolver: Send {
     }
     /// Numeric factorization of the matrix with these values (pattern order).
     fn factor(&mut self, values: &[f64]) -> Result<FactorInfo, LinearSolverError>;
-    /// Overwrites `rhs` with the solution of `A x = rhs`.
-    fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolverError>;
+    /// Overwrites `rhs` with the solution of `A x = rhs`. `values` are A's, those
+    /// given to the last `factor` and unchanged since: a backend whose solve applies
+    /// A (GMRES with a kept or single-precision factorization) reads them here
+    /// instead of keeping a copy; a direct one ignores them.
+    fn solve_in_place(&mut self, values: &[f64], rhs: &mut [f64]) -> Result<(), LinearSolverError>;
     /// Accumulated timings since construction.
     fn timings(&self) -> SolverTimings;
     /// What the last `solve_in_place` did (a direct backend: nothing to say).

@@ -4,7 +4,8 @@
 //! PETSc/AMG Krylov one under MPI, `solver::petsc`) implements [`LinearSolver`]:
 //! `analyse(pattern, symmetry)` once per sparsity pattern, `factor(values)` once
 //! per Newton iteration (for an iterative backend: build the preconditioner),
-//! `solve_in_place(rhs)` per right-hand side. The values are always in the CSC
+//! `solve_in_place(values, rhs)` per right-hand side (the values of the last
+//! `factor` again, which a Krylov backend applies without keeping a copy). The values are always in the CSC
 //! order of the pattern given to `analyse` (the order of
 //! [`crate::assembly::Pattern`] and [`crate::assembly::Assembly::values`]); a
 //! distributed backend would receive the locally owned columns in the same form.

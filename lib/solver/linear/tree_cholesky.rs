@@ -621,7 +621,7 @@ pub(super) mod tests {
             s.analyse(p.as_ref(), Symmetry::Symmetric)?;
             s.factor(v)?;
             let mut x = b.to_vec();
-            s.solve_in_place(&mut x)?;
+            s.solve_in_place(&v, &mut x)?;
             Ok(x)
         })
     }

@@ -202,7 +202,7 @@ impl Newton<'_> {
             // K_ff Δu_f = −R_f; Δu is kept in r_free for the next energy norm.
             self.r_free.iter_mut().zip(&self.rhs).for_each(|(du, r)| *du = -r);
             let solve_span = timeline::span("linear solver: solve");
-            self.linear.solve_in_place(&mut self.r_free).map_err(|error| IncrementFailure::Linear { iteration, error })?;
+            self.linear.solve_in_place(self.assembly.values(), &mut self.r_free).map_err(|error| IncrementFailure::Linear { iteration, error })?;
             drop(solve_span);
             row.seconds_solve = clock::seconds_since(t);
             let report = self.linear.last_solve();

@@ -415,7 +415,7 @@ impl LinearSolver for PetscKrylov {
         Ok(FactorInfo { method: Factorization::Multigrid, time })
     }
 
-    fn solve_in_place(&mut self, rhs: &mut [f64]) -> Result<(), LinearSolverError> {
+    fn solve_in_place(&mut self, _values: &[f64], rhs: &mut [f64]) -> Result<(), LinearSolverError> {
         let start = Instant::now();
         let _guard = runtime::LOCK.lock().unwrap_or_else(|p| p.into_inner());
         if self.mat.is_null() || self.ksp.is_null() {
@@ -546,7 +546,7 @@ mod tests {
         s.analyse(p.symbolic(), Symmetry::Symmetric).unwrap();
         assert_eq!(s.factor(cube.assembly.values()).unwrap().method, Factorization::Multigrid);
         let mut x = cube.rhs.clone();
-        s.solve_in_place(&mut x).unwrap();
+        s.solve_in_place(cube.assembly.values(), &mut x).unwrap();
         let r = relative_residual(p.col_ptr(), p.row_idx(), cube.assembly.values(), &x, &cube.rhs);
         let its = s.last_solve().krylov_iterations;
         // CG's recurrence residual vs the true one: agree to a few ulps × condition
@@ -556,7 +556,7 @@ mod tests {
         // the next factor keeps the hierarchy (same values: same iterations)
         s.factor(cube.assembly.values()).unwrap();
         let mut y = cube.rhs.clone();
-        s.solve_in_place(&mut y).unwrap();
+        s.solve_in_place(cube.assembly.values(), &mut y).unwrap();
         assert_eq!(s.timings().n_reused, 1);
         assert!(s.last_solve().krylov_iterations <= its + 1);
     }
@@ -576,7 +576,7 @@ mod tests {
         s.analyse(p.symbolic(), Symmetry::General).unwrap();
         s.factor(&values).unwrap();
         let mut x = cube.rhs.clone();
-        s.solve_in_place(&mut x).unwrap();
+        s.solve_in_place(&values, &mut x).unwrap();
         let why = s.last_solve().fallback.expect("fallback reported");
         assert!(why.contains("2 non-positive diagonal entries") && why.contains("MUMPS"), "{why}");
         let r = relative_residual(p.col_ptr(), p.row_idx(), &values, &x, &cube.rhs);
@@ -584,13 +584,13 @@ mod tests {
         assert!(s.fallback.is_null(), "the MUMPS factors are freed");
         s.factor(cube.assembly.values()).unwrap();
         let mut y = cube.rhs.clone();
-        s.solve_in_place(&mut y).unwrap();
+        s.solve_in_place(cube.assembly.values(), &mut y).unwrap();
         assert!(s.last_solve().fallback.is_none() && s.last_solve().krylov_iterations > 0);
         assert_eq!(s.timings().n_fallback, 1);
         // above the fallback's size limit the solve fails (Newton then cuts back)
         s.settings.direct_fallback_max_dofs = 10;
         s.factor(&values).unwrap();
-        let e = s.solve_in_place(&mut cube.rhs.clone()).unwrap_err().to_string();
+        let e = s.solve_in_place(&values, &mut cube.rhs.clone()).unwrap_err().to_string();
         assert!(e.contains("non-positive diagonal") && e.contains("direct_fallback_max_dofs = 10"), "{e}");
     }
 
@@ -602,7 +602,7 @@ mod tests {
         s.analyse(p.symbolic(), Symmetry::General).unwrap();
         s.factor(cube.assembly.values()).unwrap();
         let mut x = cube.rhs.clone();
-        s.solve_in_place(&mut x).unwrap();
+        s.solve_in_place(cube.assembly.values(), &mut x).unwrap();
         let why = s.last_solve().fallback.expect("fallback reported");
         assert!(why.contains("2 iterations") && why.contains("KSP_DIVERGED_ITS"), "{why}");
         assert!(relative_residual(p.col_ptr(), p.row_idx(), cube.assembly.values(), &x, &cube.rhs) <= 1e-10);
