@@ -149,10 +149,12 @@ pub struct Converged {
 impl<'p> Newton<'p> {
     pub fn new(problem: &'p Problem, settings: NewtonSetup, linear_setup: LinearSolverSetup) -> Result<Self, SetupFailure> {
         let choice = linear_setup.method;
+        let pairs_span = timeline::span("set-up: contact pairs (masters, projectors)");
         let mut contact = Vec::with_capacity(problem.contact.len());
         for def in &problem.contact {
             contact.push(PairSolver::new(def, &problem.X)?);
         }
+        drop(pairs_span);
         let (_, ranks) = ranks::rank_and_size();
         let n_dofs = (DOFS_PER_NODE * problem.n_nodes()) as u64;
         let petsc = match choice {
@@ -173,7 +175,9 @@ impl<'p> Newton<'p> {
         // several ranks share the work (only the PETSc backend can: checked above)
         let partition = (ranks > 1).then(|| Partition::new(problem));
         let (mut owners, mut groups) = (Vec::new(), NodeGroups::new());
+        let groups_span = timeline::span("set-up: first contact search (groups)");
         contact_groups(problem, &mut contact, &vec![0.0; DOFS_PER_NODE * problem.n_nodes()], &mut groups, &mut owners, partition.as_ref())?;
+        drop(groups_span);
         if let Some(part) = &partition {
             part.keep_local_groups(&mut groups, &mut owners);
         }

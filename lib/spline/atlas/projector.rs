@@ -41,6 +41,9 @@ pub struct AtlasProjector {
 const UNIT: ([f64; 2], [f64; 2]) = ([0.0; 2], [1.0; 2]);
 /// Samples per direction and chart.
 const S: usize = 3;
+/// Below this many samples a refit runs on the calling thread (a chart's jet costs
+/// about ten times a B-spline patch's sample: about 0.1 ms in all).
+const PARALLEL_SAMPLES: usize = 512;
 /// Foot points on two charts whose distances differ by no more than this fraction
 /// of the surface's size are a tie (broken by the chart number).
 const TIE: f64 = 1e-10;
@@ -64,11 +67,19 @@ impl AtlasProjector {
 
     fn refit_samples(&mut self) {
         let atlas = &self.atlas;
-        self.samples.par_chunks_mut(S * S).enumerate().for_each(|(c, out)| {
+        let refit_chart = |(c, out): (usize, &mut [Vec3])| {
             for (k, y) in out.iter_mut().enumerate() {
                 *y = atlas.jet(c, sample_uv(k)).x;
             }
-        });
+        };
+        // a small atlas on the calling thread: handed to a busy pool (its start-up,
+        // the first analysis) the caller waits milliseconds for tens of microseconds
+        // of work (as the B-spline projector's samples)
+        if self.samples.len() < PARALLEL_SAMPLES {
+            self.samples.chunks_mut(S * S).enumerate().for_each(refit_chart);
+        } else {
+            self.samples.par_chunks_mut(S * S).enumerate().for_each(refit_chart);
+        }
     }
 
     /// The nearest sample of `chart` to `p`: (squared distance, its (u, v)).
