@@ -37,12 +37,8 @@ pub struct BSplineProjector {
 /// Samples per direction and knot span in the global search.
 pub const SAMPLES: usize = 3;
 
-/// Below this many samples a refit runs on the calling thread. A small one takes
-/// tens of microseconds; handed to rayon's pool while its workers are busy (their
-/// start-up and warm-up at the beginning of a solve, the first analysis beside the
-/// set-up) the caller waited 1–4 ms for them (Parisch r = 4: 1,296 samples, the
-/// first refit 1.1–2.1 ms through the pool, 0.02–0.07 ms once it is idle); 4,096
-/// samples take about 0.1 ms on one thread.
+/// Below this many samples a refit runs on the calling thread
+/// ([`super::refit_samples_in_chunks`]): 4,096 take about 0.1 ms on one thread.
 const PARALLEL_SAMPLES: usize = 4096;
 
 /// Surface points at the fixed parameters `lo + (i + ½)/SAMPLES · (hi − lo)` of every
@@ -103,11 +99,7 @@ impl SpanSamples {
                 }
             }
         };
-        if self.points.len() < PARALLEL_SAMPLES {
-            self.points.chunks_mut(nsa * m2).enumerate().for_each(refit_row);
-        } else {
-            self.points.par_chunks_mut(nsa * m2).enumerate().for_each(refit_row);
-        }
+        super::refit_samples_in_chunks(&mut self.points, nsa * m2, PARALLEL_SAMPLES, refit_row);
     }
 
     /// Parameter of sample `k`.

@@ -20,7 +20,6 @@
 //!      [`SurfacePoint::hold_on_crease`]);
 //!    - a smooth join: nothing, the neighbouring chart holds the orthogonal foot point.
 
-use rayon::prelude::*;
 
 use super::super::closest_point::{newton, NewtonResult};
 use super::super::{Projection, ProjectionOptions, SplineError, SurfacePoint, Vec3};
@@ -41,8 +40,9 @@ pub struct AtlasProjector {
 const UNIT: ([f64; 2], [f64; 2]) = ([0.0; 2], [1.0; 2]);
 /// Samples per direction and chart.
 const S: usize = 3;
-/// Below this many samples a refit runs on the calling thread (a chart's jet costs
-/// about ten times a B-spline patch's sample: about 0.1 ms in all).
+/// Below this many samples a refit runs on the calling thread
+/// ([`super::super::refit_samples_in_chunks`]; a chart's jet costs about ten times a
+/// B-spline patch's sample: about 0.1 ms in all).
 const PARALLEL_SAMPLES: usize = 512;
 /// Foot points on two charts whose distances differ by no more than this fraction
 /// of the surface's size are a tie (broken by the chart number).
@@ -72,14 +72,7 @@ impl AtlasProjector {
                 *y = atlas.jet(c, sample_uv(k)).x;
             }
         };
-        // a small atlas on the calling thread: handed to a busy pool (its start-up,
-        // the first analysis) the caller waits milliseconds for tens of microseconds
-        // of work (as the B-spline projector's samples)
-        if self.samples.len() < PARALLEL_SAMPLES {
-            self.samples.chunks_mut(S * S).enumerate().for_each(refit_chart);
-        } else {
-            self.samples.par_chunks_mut(S * S).enumerate().for_each(refit_chart);
-        }
+        super::super::refit_samples_in_chunks(&mut self.samples, S * S, PARALLEL_SAMPLES, refit_chart);
     }
 
     /// The nearest sample of `chart` to `p`: (squared distance, its (u, v)).
