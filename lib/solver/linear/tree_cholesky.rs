@@ -23,11 +23,19 @@
 //!    from `s₀` on: `W = L_d,low L_d,midᵀ` (dense, into a buffer, by panels of
 //!    columns that keep it under 1/64 of the factor's size, at least
 //!    [`W_ENTRIES`]), then `L_s[rows, cols] -= W`
-//!    through the row map of `s`;
+//!    through the row map of `s`. Where these updates are heavy (the top of the
+//!    tree, which waits for everything below it), they run as parallel tasks, each
+//!    for its own chunk of the columns of `L_s` and every descendant in turn
+//!    ([`CHUNK_FLOPS`]);
 //! 3. `L_s,top = chol(L_s,top)`, `L_s,bot ← L_s,bot L_s,top⁻ᵀ`.
 //!
 //! **Determinism.** Each supernode's operations and their order are fixed by the
 //! symbolic factorization alone; which thread runs them does not change a bit.
+//! The column chunks of step 2 are fixed by the symbolic factorization too, and a
+//! chunk applies the descendants in the same order as the unchunked loop, and the
+//! dense products give each entry of `W` the same sum whatever panel it is
+//! computed in: the factor is the same bit for bit with chunks or without
+//! (`faer_direct::tests`, against faer's own factorization).
 //! The factor is therefore the same for any number of threads, except where the
 //! dense kernels of one supernode are themselves given several threads
 //! ([`TreeCholesky::factor`]'s `par`, used only for the supernodes above the last
@@ -44,8 +52,8 @@
 //! factored them before it, children before parents, or a child task that was
 //! joined before): the blocks a thread writes are never read or written by
 //! another thread at the same time. A large update's scatter splits the columns
-//! of `L_s` among threads; distinct columns of `L_d,mid` land in distinct columns
-//! of `L_s`.
+//! of `L_s` among threads, and so do the chunk tasks of step 2; distinct columns
+//! of `L_d,mid` land in distinct columns of `L_s`.
 
 use std::cell::Cell;
 
@@ -110,6 +118,21 @@ const W_ENTRIES: usize = 1 << 17;
 /// several threads (when the supernode's `par` has them).
 const PARALLEL_SCATTER: usize = 1 << 16;
 
+/// The descendants' updates of a supernode that cost this many flops (~0.1 ms)
+/// or more are split by columns of `L_s` into chunks of at least this much work
+/// (at most [`MAX_CHUNKS`], at least [`CHUNK_MIN_COLUMNS`] columns each), run as
+/// parallel tasks: the supernodes at the top of the tree wait for all others
+/// and have the most updates (Parisch r = 4: the root, 486 columns, 129 updates,
+/// 1.5 ms of a 7.5 ms factorization on one core while the other idled). A chunk
+/// applies each descendant's update to its own columns, in the same order of the
+/// descendants: the chunks, fixed by the symbolic factor alone, are the same for
+/// any number of threads.
+const CHUNK_FLOPS: f64 = 4.0e6;
+/// See [`CHUNK_FLOPS`].
+const MAX_CHUNKS: usize = 8;
+/// See [`CHUNK_FLOPS`].
+const CHUNK_MIN_COLUMNS: usize = 16;
+
 /// A subtree whose factorization costs less than this many flops runs as one
 /// sequential task (spawning costs microseconds; this is ~0.1 ms of work).
 const TASK_FLOPS: f64 = 2.0e6;
@@ -131,6 +154,10 @@ pub struct TreeCholesky {
     /// Entries of the factor in the subtree of `s` (the work of its triangular
     /// solves, [`super::tree_solve`]).
     pub(super) subtree_entries: Vec<usize>,
+    /// `chunks[s]`: the column bounds (local, from 0 to the width of `s`) of the
+    /// chunks of `L_s` whose descendants' updates run as parallel tasks, or empty
+    /// (they run in the task of `s`): [`CHUNK_FLOPS`].
+    pub(super) chunks: Vec<Vec<usize>>,
 }
 
 /// The raw value array shared by the tasks (see the module's **Safety**).
@@ -193,6 +220,12 @@ thread_local! {
     static SCRATCH: Cell<Option<Box<Scratch>>> = const { Cell::new(None) };
 }
 
+thread_local! {
+    /// The update buffers of a chunk task ([`CHUNK_FLOPS`]), apart from
+    /// [`SCRATCH`], which the task of the supernode holds while its chunks run.
+    static CHUNK_SCRATCH: Cell<Option<Box<Scratch>>> = const { Cell::new(None) };
+}
+
 const NONE: usize = usize::MAX;
 
 impl TreeCholesky {
@@ -212,6 +245,7 @@ impl TreeCholesky {
         let mut updaters = vec![Vec::new(); n_super];
         let mut own_flops = vec![0.0; n_super];
         let mut subtree_entries = vec![0usize; n_super];
+        let mut update_flops = vec![0.0; n_super];
         for d in 0..n_super {
             let pattern = &rows[row_ptr[d]..row_ptr[d + 1]];
             let c = (end[d] - begin[d]) as f64;
@@ -224,14 +258,40 @@ impl TreeCholesky {
                 None => roots.push(d),
             }
             let mut last = NONE;
-            for &r in pattern {
+            for (i, &r) in pattern.iter().enumerate() {
                 let s = super_of[r];
                 if s != last {
                     updaters[s].push(d);
                     last = s;
                 }
+                // row r of L_d,mid: a column of W with the rows of L_d,low from it on
+                update_flops[s] += 2.0 * c * (pattern.len() - i) as f64;
             }
         }
+        let chunks = (0..n_super)
+            .map(|s| {
+                let n_chunks = (update_flops[s] / CHUNK_FLOPS) as usize;
+                let ncols = end[s] - begin[s];
+                if n_chunks < 2 || ncols < 2 * CHUNK_MIN_COLUMNS {
+                    return Vec::new();
+                }
+                let n_chunks = n_chunks.min(MAX_CHUNKS).min(ncols / CHUNK_MIN_COLUMNS);
+                // column j of L_s takes updates on its rows from j down: weight nrows − j
+                let nrows = ncols + (row_ptr[s + 1] - row_ptr[s]);
+                let total: usize = (0..ncols).map(|j| nrows - j).sum();
+                let mut bounds = vec![0];
+                let mut acc = 0;
+                for j in 0..ncols {
+                    acc += nrows - j;
+                    if acc * n_chunks >= total * bounds.len() && bounds.len() < n_chunks {
+                        bounds.push(j + 1);
+                    }
+                }
+                bounds.push(ncols);
+                bounds.dedup();
+                bounds
+            })
+            .collect();
         let mut subtree_flops = own_flops;
         for s in 0..n_super {
             // children have smaller numbers than their parent
@@ -242,7 +302,7 @@ impl TreeCholesky {
                 subtree_entries[s] += e;
             }
         }
-        Self { children, roots, subtree_flops, updaters, subtree_entries }
+        Self { children, roots, subtree_flops, updaters, subtree_entries, chunks }
     }
 
     /// `visit` every supernode of the subtree of `root`, children before parents
@@ -389,6 +449,88 @@ impl<T: FactorReal> Context<'_, T> {
         }
     }
 
+    /// `L_s[rows, cols] -= W` of descendant `d` (step 2 of the module's algorithm)
+    /// for the columns `cols` of `L_s` (local, `0..s_ncols` for all): `W = L_d,low
+    /// L_d,midᵀ` over the rows of `L_d,mid` that fall in `cols`, by panels. `local`
+    /// maps the rows of `s` to its block's rows; `ls_cols` is `L_s` (column-major);
+    /// the caller owns its columns `cols`.
+    #[allow(clippy::too_many_arguments)]
+    fn update(&self, s: usize, d: usize, cols: std::ops::Range<usize>, ls_cols: SharedValues<T>, local: &[usize], buffer: &mut Vec<T>, map: &mut Vec<usize>, par: Par) {
+        let sym = self.symbolic;
+        let (begin, end) = (sym.supernode_begin(), sym.supernode_end());
+        let row_ptr = sym.col_ptr_for_row_idx();
+        let val_ptr = sym.col_ptr_for_val();
+        let rows = sym.row_idx();
+        let (s0, s1) = (begin[s], end[s]);
+        let s_nrows = ls_cols.len / (s1 - s0);
+        let (d0, d1) = (begin[d], end[d]);
+        let d_ncols = d1 - d0;
+        let d_pattern = &rows[row_ptr[d]..row_ptr[d + 1]];
+        let d_nrows = d_ncols + d_pattern.len();
+        // SAFETY: `d` is a finished descendant of `s`: read only.
+        let ld = unsafe { self.values.slice(val_ptr[d], val_ptr[d + 1] - val_ptr[d]) };
+        let ld = MatRef::from_column_major_slice(ld, d_nrows, d_ncols);
+        let p0 = d_pattern.partition_point(|&r| r < s0);
+        let mid = d_pattern[p0..].partition_point(|&r| r < s1);
+        // the rows of L_d,mid in the columns `cols` of L_s: [a, b) of mid
+        let a = d_pattern[p0..p0 + mid].partition_point(|&r| r < s0 + cols.start);
+        let b = d_pattern[p0..p0 + mid].partition_point(|&r| r < s0 + cols.end);
+        if a == b {
+            return;
+        }
+        let low = d_pattern.len() - p0;
+        let ld_low = ld.subrows(d_ncols + p0, low);
+        let ld_mid = ld_low.subrows(0, mid);
+        // the rows of W in L_s
+        map.clear();
+        map.extend(d_pattern[p0..].iter().map(|&r| if r < s1 { r - s0 } else { local[r] }));
+        // W = L_low L_midᵀ by panels of the mid columns [j0, j1), each the lower
+        // triangle of its top block and the rectangle below (the buffer stays
+        // under w_entries however large the update)
+        let width = (self.w_entries / low.max(1)).max(32).min(mid.max(1));
+        for j0 in (a..b).step_by(width) {
+            let j1 = (j0 + width).min(b);
+            let (w_cols, w_rows) = (j1 - j0, low - j0);
+            if buffer.len() < w_rows * w_cols {
+                buffer.resize(w_rows * w_cols, T::of_f64(0.0));
+            }
+            let mut w = MatMut::from_column_major_slice_mut(&mut buffer[..w_rows * w_cols], w_rows, w_cols);
+            let panel = ld_mid.subrows(j0, w_cols);
+            let (w_top, w_bot) = w.rb_mut().split_at_row_mut(w_cols);
+            triangular::matmul(
+                w_top,
+                BlockStructure::TriangularLower,
+                Accum::Replace,
+                panel,
+                BlockStructure::Rectangular,
+                panel.transpose(),
+                BlockStructure::Rectangular,
+                T::of_f64(1.0),
+                par,
+            );
+            matmul(w_bot, Accum::Replace, ld_low.subrows(j1, low - j1), panel.transpose(), T::of_f64(1.0), par);
+            let w = w.rb();
+            let map = &map[j0..];
+            let scatter = |jj: usize, dst: &mut [T]| {
+                let w_col = w.col(jj).try_as_col_major().expect("W is column-major").as_slice();
+                for ii in jj..w_rows {
+                    dst[map[ii]] -= w_col[ii];
+                }
+            };
+            // SAFETY: L_s is column-major with s_nrows rows, and the columns
+            // d_pattern[p0 + j] − s₀ are distinct for distinct j, all in `cols`,
+            // which the caller owns: each call writes its own column
+            let column = |jj: usize| unsafe { ls_cols.slice_mut((d_pattern[p0 + j0 + jj] - s0) * s_nrows, s_nrows) };
+            if matches!(par, Par::Rayon(_)) && w_rows * w_cols >= PARALLEL_SCATTER {
+                (0..w_cols).into_par_iter().for_each(|jj| scatter(jj, column(jj)));
+            } else {
+                for jj in 0..w_cols {
+                    scatter(jj, column(jj));
+                }
+            }
+        }
+    }
+
     /// Steps 1–3 of the module's algorithm for supernode `s`.
     fn supernode(&self, s: usize, par: Par) {
         let sym = self.symbolic;
@@ -428,68 +570,29 @@ impl<T: FactorReal> Context<'_, T> {
                     ls[(row, col)] += T::of_f64(self.scale * v);
                 }
             }
-            // 2. the updates of the descendants
-            for &d in &self.tree.updaters[s] {
-                let (d0, d1) = (begin[d], end[d]);
-                let d_ncols = d1 - d0;
-                let d_pattern = &rows[row_ptr[d]..row_ptr[d + 1]];
-                let d_nrows = d_ncols + d_pattern.len();
-                // SAFETY: `d` is a finished descendant of `s`: read only.
-                let ld = unsafe { self.values.slice(val_ptr[d], val_ptr[d + 1] - val_ptr[d]) };
-                let ld = MatRef::from_column_major_slice(ld, d_nrows, d_ncols);
-                let p0 = d_pattern.partition_point(|&r| r < s0);
-                let mid = d_pattern[p0..].partition_point(|&r| r < s1);
-                let low = d_pattern.len() - p0;
-                let ld_low = ld.subrows(d_ncols + p0, low);
-                let ld_mid = ld_low.subrows(0, mid);
-                // the rows of W in L_s
-                map.clear();
-                map.extend(d_pattern[p0..].iter().map(|&r| if r < s1 { r - s0 } else { local[r] }));
-                let ls_cols = SharedValues { ptr: ls.rb_mut().as_ptr_mut(), len: s_nrows * s_ncols };
-                // W = L_low L_midᵀ by panels of the mid columns [j0, j1), each the lower
-                // triangle of its top block and the rectangle below (the buffer stays
-                // under w_entries however large the update)
-                let width = (self.w_entries / low.max(1)).max(32).min(mid.max(1));
-                for j0 in (0..mid).step_by(width) {
-                    let j1 = (j0 + width).min(mid);
-                    let (w_cols, w_rows) = (j1 - j0, low - j0);
-                    if buffer.len() < w_rows * w_cols {
-                        buffer.resize(w_rows * w_cols, T::of_f64(0.0));
+            // 2. the updates of the descendants: by column chunks of L_s in parallel
+            // where they are heavy (`TreeCholesky::chunks`), else here
+            let ls_cols = SharedValues { ptr: ls.rb_mut().as_ptr_mut(), len: s_nrows * s_ncols };
+            let chunks = &self.tree.chunks[s];
+            if chunks.len() > 2 {
+                let local: &[usize] = local;
+                let run = |k: usize| {
+                    let mut mine = CHUNK_SCRATCH.with(Cell::take).unwrap_or_default();
+                    let Scratch { w, w32, map, .. } = &mut *mine;
+                    let buffer = T::buffer(w, w32);
+                    for &d in &self.tree.updaters[s] {
+                        self.update(s, d, chunks[k]..chunks[k + 1], ls_cols, local, buffer, map, Par::Seq);
                     }
-                    let mut w = MatMut::from_column_major_slice_mut(&mut buffer[..w_rows * w_cols], w_rows, w_cols);
-                    let panel = ld_mid.subrows(j0, w_cols);
-                    let (w_top, w_bot) = w.rb_mut().split_at_row_mut(w_cols);
-                    triangular::matmul(
-                        w_top,
-                        BlockStructure::TriangularLower,
-                        Accum::Replace,
-                        panel,
-                        BlockStructure::Rectangular,
-                        panel.transpose(),
-                        BlockStructure::Rectangular,
-                        T::of_f64(1.0),
-                        par,
-                    );
-                    matmul(w_bot, Accum::Replace, ld_low.subrows(j1, low - j1), panel.transpose(), T::of_f64(1.0), par);
-                    let w = w.rb();
-                    let map = &map[j0..];
-                    let scatter = |jj: usize, dst: &mut [T]| {
-                        let w_col = w.col(jj).try_as_col_major().expect("W is column-major").as_slice();
-                        for ii in jj..w_rows {
-                            dst[map[ii]] -= w_col[ii];
-                        }
-                    };
-                    // SAFETY: L_s is column-major with s_nrows rows, and the columns
-                    // d_pattern[p0 + j] − s₀ are distinct for distinct j: each call
-                    // writes its own column
-                    let column = |jj: usize| unsafe { ls_cols.slice_mut((d_pattern[p0 + j0 + jj] - s0) * s_nrows, s_nrows) };
-                    if matches!(par, Par::Rayon(_)) && w_rows * w_cols >= PARALLEL_SCATTER {
-                        (0..w_cols).into_par_iter().for_each(|jj| scatter(jj, column(jj)));
-                    } else {
-                        for jj in 0..w_cols {
-                            scatter(jj, column(jj));
-                        }
-                    }
+                    CHUNK_SCRATCH.with(|c| c.set(Some(mine)));
+                };
+                if rayon::current_num_threads() > 1 {
+                    (0..chunks.len() - 1).into_par_iter().for_each(run);
+                } else {
+                    (0..chunks.len() - 1).for_each(run);
+                }
+            } else {
+                for &d in &self.tree.updaters[s] {
+                    self.update(s, d, 0..s_ncols, ls_cols, local, buffer, map, par);
                 }
             }
             for &r in s_pattern {
@@ -664,6 +767,10 @@ pub(super) mod tests {
     #[test]
     fn the_tree_factor_is_the_same_for_any_number_of_threads() {
         let pb = cube(10);
+        // the top supernodes' updates split into column chunks run in parallel too
+        let schedule = TreeCholesky::new(pb.supernodal());
+        let chunked: Vec<_> = schedule.chunks.iter().filter(|c| c.len() > 2).collect();
+        assert!(!chunked.is_empty(), "no supernode's updates are chunked");
         // the dense kernels sequential: only the tree runs in parallel
         let bits = |l: Vec<f64>| l.into_iter().map(f64::to_bits).collect::<Vec<_>>();
         let one = bits(pb.tree_factor(1, Par::Seq).unwrap());

@@ -284,6 +284,10 @@ fn the_elimination_tree_factor_is_faers_own_bit_for_bit_with_sequential_kernels(
         s.analyse(p.as_ref(), Symmetry::Symmetric).unwrap();
         assert_eq!(pool.install(|| s.factor(cube.assembly.values())).unwrap().method, Factorization::Llt);
         assert_eq!(s.tree.is_some(), elimination_tree);
+        if let Some(tree) = &s.tree {
+            // the top supernodes' updates go by column chunks (tree_cholesky::CHUNK_FLOPS)
+            assert!(tree.chunks.iter().any(|c| c.len() > 2), "no supernode's updates are chunked");
+        }
         s.l_values
     };
     let bits = |l: Vec<f64>| l.into_iter().map(f64::to_bits).collect::<Vec<_>>();
