@@ -47,8 +47,7 @@ use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, simplicial::SimplicialLltRef, supernodal::{SupernodalLltRef, SymbolicSupernodalCholesky}, LdltRef, LltRef,
-    SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
+    factorize_symbolic_cholesky, simplicial::SimplicialLltRef, LdltRef, LltRef, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
 };
 use faer::sparse::linalg::lu::{factorize_symbolic_lu, LuRef, NumericLu, SymbolicLu};
 use faer::sparse::linalg::cholesky::CholeskySymbolicParams;
@@ -61,8 +60,9 @@ use faer::{Conj, MatMut, Par, Side};
 
 use super::error::LinearSolverError;
 use crate::os::timeline;
+use super::supernodal::Supernodal;
 use super::tree_cholesky::{FactorReal, FillPermutation, TreeCholesky};
-use crate::solver::ordering::{geometric_dissection, nested_dissection, FillOrdering};
+use crate::solver::ordering::{geometric_order_of, nested_dissection_of, FillOrdering, Permutation, SupervariableGraph};
 use super::interface::{check_values, FactorInfo, Factorization, LinearSolver, SharedPattern, SolverTimings, Symmetry};
 
 /// Widest supernode (columns) from which [`FaerDirect`] runs faer in parallel when
@@ -142,8 +142,65 @@ pub enum SymmetricStrategy {
 }
 
 enum Symbolic {
-    Cholesky(SymbolicCholesky<usize>),
+    Cholesky(CholeskySymbolic),
     Lu(SymbolicLu<usize>),
+}
+
+/// The analysis of a symmetric pattern: the fill-reducing permutation, the
+/// supernodal structure the tree factorization and its solves read, and faer's
+/// symbolic factorization for faer's own numeric ones (`LDLᵀ`; `LLᵀ` without the
+/// tree). Under nested dissection (METIS or geometric) with the tree the structure
+/// is computed on the supervariables ([`Supernodal::of_supervariables`], faer's
+/// own, a tenth of its time) and faer's symbolic factorization only when an
+/// `LDLᵀ` needs it ([`FaerDirect::ensure_faer_symbolic`]); otherwise faer's is
+/// made at once and the structure copied from it.
+struct CholeskySymbolic {
+    /// `P`: column `j` of `P A Pᵀ` is column `perm.forward[j]` of `A`.
+    perm: Permutation,
+    /// `None` only for a simplicial faer factor.
+    structure: Option<Supernodal>,
+    faer: Option<SymbolicCholesky<usize>>,
+}
+
+impl CholeskySymbolic {
+    fn of_faer(c: SymbolicCholesky<usize>) -> Self {
+        let n = c.nrows();
+        let perm = match c.perm() {
+            Some(p) => {
+                let (forward, inverse) = p.arrays();
+                Permutation { forward: forward.to_vec(), inverse: inverse.to_vec() }
+            }
+            None => Permutation { forward: (0..n).collect(), inverse: (0..n).collect() },
+        };
+        let structure = match c.raw() {
+            SymbolicCholeskyRaw::Supernodal(s) => Some(Supernodal::of_faer(s)),
+            SymbolicCholeskyRaw::Simplicial(_) => None,
+        };
+        Self { perm, structure, faer: Some(c) }
+    }
+
+    fn len_val(&self) -> usize {
+        match (&self.structure, &self.faer) {
+            (Some(s), _) => s.len_val(),
+            (None, Some(c)) => c.len_val(),
+            (None, None) => 0,
+        }
+    }
+
+    /// faer's symbolic factorization, if made.
+    fn faer(&self) -> Result<&SymbolicCholesky<usize>, LinearSolverError> {
+        self.faer.as_ref().ok_or(LinearSolverError::Order("a faer factorization", "its symbolic analysis"))
+    }
+}
+
+/// faer's symbolic factorization of `pattern` (both triangles, its lower one read)
+/// in the order `ordering`, supernodal always: faer's automatic choice takes the
+/// simplicial factorization when flops / nnz(L) < 40, as on the shallow ironing's
+/// one-element-thick slab (4.5k unknowns), where the supernodal one (each node's 3
+/// dofs a dense block at least) factors in half the time (docs/performance.md).
+fn faer_symbolic(pattern: SymbolicSparseColMatRef<'_, usize>, ordering: SymmetricOrdering<'_, usize>) -> Result<SymbolicCholesky<usize>, LinearSolverError> {
+    let params = CholeskySymbolicParams { supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL, ..Default::default() };
+    factorize_symbolic_cholesky(pattern, Side::Lower, ordering, params).map_err(|e| LinearSolverError::Faer(format!("{e:?}")))
 }
 
 enum Numeric {
@@ -241,7 +298,7 @@ impl FaerDirect {
     /// Number of stored values of the factor(s), a proxy for its memory.
     pub fn factor_len(&self) -> usize {
         match (&self.symbolic, &self.numeric) {
-            (Some(Symbolic::Cholesky(s)), _) => s.len_val(),
+            (Some(Symbolic::Cholesky(c)), _) => c.len_val(),
             _ => 0,
         }
     }
@@ -278,22 +335,44 @@ impl FaerDirect {
         self.options.par.unwrap_or_else(|| if self.widest_supernode >= PARALLEL_SUPERNODE { faer::get_global_parallelism() } else { Par::Seq })
     }
 
+    /// faer's symbolic factorization of the analysed pattern in the analysis'
+    /// order, made now if the analysis did without it (its time counted with the
+    /// analyses').
+    fn ensure_faer_symbolic(&mut self) -> Result<(), LinearSolverError> {
+        let (Some(pattern), Some(Symbolic::Cholesky(c))) = (&self.pattern, &mut self.symbolic) else {
+            return Err(LinearSolverError::Order("factor", "analyse"));
+        };
+        if c.faer.is_none() {
+            let start = Instant::now();
+            let n = c.perm.forward.len();
+            let ordering = SymmetricOrdering::Custom(PermRef::new_checked(&c.perm.forward, &c.perm.inverse, n));
+            c.faer = Some(faer_symbolic((**pattern).as_ref(), ordering)?);
+            self.symbolic_time += start.elapsed();
+        }
+        Ok(())
+    }
+
     fn factor_cholesky(&mut self, values: &[f64]) -> Result<Numeric, LinearSolverError> {
         let par = self.par();
+        let strategy = self.options.symmetric;
+        // faer's numeric factorizations need its symbolic one: LDLᵀ, and LLᵀ
+        // without the tree
+        if strategy == SymmetricStrategy::Ldlt || self.tree.is_none() {
+            self.ensure_faer_symbolic()?;
+        }
         let (Some(pattern), Some(Symbolic::Cholesky(sym))) = (&self.pattern, &self.symbolic) else {
             return Err(LinearSolverError::Order("factor", "analyse"));
         };
         let a = SparseColMatRef::new((**pattern).as_ref(), values);
-        let orig = |j: usize| sym.perm().map_or(j, |p| p.arrays().0[j]);
         // faer 0.24 reports failed pivots 1-based in the simplicial path
         // (`index: k + 1`) and 0-based in the supernodal one.
-        let simplicial = matches!(sym.raw(), SymbolicCholeskyRaw::Simplicial(_));
-        let failed = |index: usize| orig(if simplicial { index.saturating_sub(1) } else { index });
+        let simplicial = sym.structure.is_none();
+        let forward = &sym.perm.forward;
+        let failed = |index: usize| forward[if simplicial { index.saturating_sub(1) } else { index }];
 
-        let strategy = self.options.symmetric;
         let mut method = Factorization::Ldlt;
-        let tree = match (&self.tree, sym.raw()) {
-            (Some(tree), SymbolicCholeskyRaw::Supernodal(s)) => Some((tree, s)),
+        let tree = match (&self.tree, &sym.structure) {
+            (Some(tree), Some(s)) => Some((tree, s)),
             _ => None,
         };
         if strategy != SymmetricStrategy::Ldlt {
@@ -301,36 +380,34 @@ impl FaerDirect {
                 Some((tree, s)) => {
                     // A itself, read through P: the tree factorization takes the
                     // entries on or below the diagonal of P A Pᵀ (no permuted copy)
-                    let perm = sym.perm().map(|p| {
-                        let (forward, inverse) = p.arrays();
-                        FillPermutation { forward, inverse }
-                    });
+                    let perm = Some(FillPermutation { forward: &sym.perm.forward, inverse: &sym.perm.inverse });
                     let dense_par = self.options.par.unwrap_or_else(faer::get_global_parallelism);
                     // the tasks write every block: no zeroing pass here, and the pages of a
                     // new factor are first touched in parallel (calloc'd, not written)
                     if let (FactorPrecision::Single, Some(scale)) = (self.options.precision, single_scale(values, &self.diag_pos)) {
                         // the double factor goes first (peak memory)
                         self.l_values = Vec::new();
-                        if self.l_values32.len() != sym.len_val() {
-                            self.l_values32 = vec![0.0; sym.len_val()];
+                        if self.l_values32.len() != s.len_val() {
+                            self.l_values32 = vec![0.0; s.len_val()];
                         }
                         let factored = tree.factor_scaled(s, a, perm, scale, &mut self.l_values32, dense_par).is_ok();
-                        if factored && single_pivots_hold(sym, &self.l_values32, values, &self.diag_pos, scale, orig) {
+                        if factored && single_pivots_hold(s, &self.l_values32, values, &self.diag_pos, scale, |j| forward[j]) {
                             return Ok(Numeric::LltSingle { scale });
                         }
                     }
                     self.l_values32 = Vec::new();
-                    if self.l_values.len() != sym.len_val() {
-                        self.l_values = vec![0.0; sym.len_val()];
+                    if self.l_values.len() != s.len_val() {
+                        self.l_values = vec![0.0; s.len_val()];
                     }
                     tree.factor(s, a, perm, &mut self.l_values, dense_par)
                 }
                 None => {
+                    let faer = sym.faer()?;
                     self.l_values32 = Vec::new();
-                    self.l_values.resize(sym.len_val(), 0.0);
-                    let mut buf = MemBuffer::try_new(sym.factorize_numeric_llt_scratch::<f64>(par, Default::default()))
+                    self.l_values.resize(faer.len_val(), 0.0);
+                    let mut buf = MemBuffer::try_new(faer.factorize_numeric_llt_scratch::<f64>(par, Default::default()))
                         .map_err(|e| LinearSolverError::Faer(format!("{e:?}")))?;
-                    sym.factorize_numeric_llt(
+                    faer.factorize_numeric_llt(
                         &mut self.l_values,
                         a,
                         Side::Lower,
@@ -353,10 +430,18 @@ impl FaerDirect {
         }
         if method == Factorization::Ldlt {
             self.l_values32 = Vec::new();
-            self.l_values.resize(sym.len_val(), 0.0);
-            let mut buf = MemBuffer::try_new(sym.factorize_numeric_ldlt_scratch::<f64>(par, Default::default()))
+            self.ensure_faer_symbolic()?;
+            let (Some(pattern), Some(Symbolic::Cholesky(sym))) = (&self.pattern, &self.symbolic) else {
+                return Err(LinearSolverError::Order("factor", "analyse"));
+            };
+            let a = SparseColMatRef::new((**pattern).as_ref(), values);
+            let faer = sym.faer()?;
+            let forward = &sym.perm.forward;
+            let failed = |index: usize| forward[if simplicial { index.saturating_sub(1) } else { index }];
+            self.l_values.resize(faer.len_val(), 0.0);
+            let mut buf = MemBuffer::try_new(faer.factorize_numeric_ldlt_scratch::<f64>(par, Default::default()))
                 .map_err(|e| LinearSolverError::Faer(format!("{e:?}")))?;
-            let ldlt = sym.factorize_numeric_ldlt(
+            let ldlt = faer.factorize_numeric_ldlt(
                 &mut self.l_values,
                 a,
                 Side::Lower,
@@ -369,6 +454,10 @@ impl FaerDirect {
                 return Err(LinearSolverError::Singular { dof: Some(failed(index)) });
             }
         }
+        let Some(Symbolic::Cholesky(sym)) = &self.symbolic else {
+            return Err(LinearSolverError::Order("factor", "analyse"));
+        };
+        let orig = |j: usize| sym.perm.forward[j];
 
         // Round-off-small pivots: compare each pivot with its diagonal entry.
         let tol = self.options.singular_pivot_tolerance;
@@ -408,8 +497,8 @@ fn inverse_power_of_two(largest: f64) -> Option<f64> {
 
 /// Whether every pivot `L_jj²` of a single-precision factor of `scale · A` is
 /// finite and at least [`SINGLE_PIVOT_FLOOR`] of its diagonal entry `scale · a_jj`.
-fn single_pivots_hold(sym: &SymbolicCholesky<usize>, l_values: &[f32], values: &[f64], diag_pos: &[usize], scale: f64, orig: impl Fn(usize) -> usize) -> bool {
-    factor_diagonal(sym, l_values).iter().enumerate().all(|(j, &l)| {
+fn single_pivots_hold(structure: &Supernodal, l_values: &[f32], values: &[f64], diag_pos: &[usize], scale: f64, orig: impl Fn(usize) -> usize) -> bool {
+    supernodal_diagonal(structure, l_values).iter().enumerate().all(|(j, &l)| {
         let p = diag_pos[orig(j)];
         let a_jj = if p == usize::MAX { 0.0 } else { scale * values[p] };
         let d = l * l;
@@ -419,29 +508,35 @@ fn single_pivots_hold(sym: &SymbolicCholesky<usize>, l_values: &[f32], values: &
 
 /// Diagonal of a Cholesky-type factor in the permuted order: `L_jj` for `LLᵀ`,
 /// `D_jj` for `LDLᵀ` (both are stored on the factor's diagonal).
-fn factor_diagonal<T: super::tree_cholesky::FactorReal>(sym: &SymbolicCholesky<usize>, values: &[T]) -> Vec<f64> {
-    let n = sym.nrows();
-    let mut diag = vec![0.0; n];
-    match sym.raw() {
-        SymbolicCholeskyRaw::Simplicial(s) => {
-            let l = SimplicialLltRef::new(s, values);
-            let f = s.factor();
-            for (j, d) in diag.iter_mut().enumerate() {
-                let (lo, hi) = (f.col_ptr()[j], f.col_ptr()[j + 1]);
-                if let Some(k) = f.row_idx()[lo..hi].iter().position(|&r| r == j) {
-                    *d = l.values()[lo + k].to_f64();
-                }
+fn factor_diagonal<T: super::tree_cholesky::FactorReal>(sym: &CholeskySymbolic, values: &[T]) -> Vec<f64> {
+    match (&sym.structure, &sym.faer) {
+        (Some(s), _) => supernodal_diagonal(s, values),
+        (None, Some(c)) => match c.raw() {
+            SymbolicCholeskyRaw::Simplicial(s) => {
+                let l = SimplicialLltRef::new(s, values);
+                let f = s.factor();
+                (0..c.nrows())
+                    .map(|j| {
+                        let (lo, hi) = (f.col_ptr()[j], f.col_ptr()[j + 1]);
+                        f.row_idx()[lo..hi].iter().position(|&r| r == j).map_or(0.0, |k| l.values()[lo + k].to_f64())
+                    })
+                    .collect()
             }
-        }
-        SymbolicCholeskyRaw::Supernodal(s) => {
-            let l = SupernodalLltRef::new(s, values);
-            for sn in 0..s.n_supernodes() {
-                let node = l.supernode(sn);
-                let (start, m) = (node.start(), node.val());
-                for k in 0..m.ncols() {
-                    diag[start + k] = m[(k, k)].to_f64();
-                }
-            }
+            SymbolicCholeskyRaw::Supernodal(s) => supernodal_diagonal(&Supernodal::of_faer(s), values),
+        },
+        (None, None) => Vec::new(),
+    }
+}
+
+/// The diagonal of a supernodal factor: entry `(k, k)` of each supernode's block.
+fn supernodal_diagonal<T: super::tree_cholesky::FactorReal>(s: &Supernodal, values: &[T]) -> Vec<f64> {
+    let mut diag = vec![0.0; s.nrows()];
+    let (begin, end, val_ptr) = (s.supernode_begin(), s.supernode_end(), s.col_ptr_for_val());
+    for sn in 0..s.n_supernodes() {
+        let ncols = end[sn] - begin[sn];
+        let nrows = (val_ptr[sn + 1] - val_ptr[sn]) / ncols.max(1);
+        for k in 0..ncols {
+            diag[begin[sn] + k] = values[val_ptr[sn] + k * nrows + k].to_f64();
         }
     }
     diag
@@ -611,10 +706,10 @@ impl FaerDirect {
         let (Some(tree), Some(Symbolic::Cholesky(sym))) = (&self.tree, &self.symbolic) else {
             return false;
         };
-        let (SymbolicCholeskyRaw::Supernodal(s), Some(perm)) = (sym.raw(), sym.perm()) else {
+        let Some(s) = &sym.structure else {
             return false;
         };
-        let fwd = perm.arrays().0;
+        let fwd = &sym.perm.forward[..];
         // a solve already under way on this solver (another thread's, or one a
         // waiting rayon worker took up) keeps the kept arrays: this one makes its own
         let (mut held, mut own) = (self.solve_scratch.try_lock().ok(), SolveScratch::default());
@@ -648,12 +743,14 @@ impl FaerDirect {
         // the tree's own solve for the factors it made, faer's for the others
         if !self.solve_by_tree(rhs) {
             match (&self.symbolic, &self.numeric) {
-                (Some(Symbolic::Cholesky(sym)), Numeric::Llt) => {
+                (Some(Symbolic::Cholesky(c)), Numeric::Llt) => {
+                    let sym = c.faer()?;
                     let x = MatMut::from_column_major_slice_mut(rhs, n, 1);
                     let mut buf = MemBuffer::try_new(sym.solve_in_place_scratch::<f64>(1, par)).map_err(faer_err)?;
                     LltRef::new(sym, &self.l_values).solve_in_place_with_conj(Conj::No, x, par, MemStack::new(&mut buf));
                 }
-                (Some(Symbolic::Cholesky(sym)), &Numeric::LltSingle { scale }) => {
+                (Some(Symbolic::Cholesky(c)), &Numeric::LltSingle { scale }) => {
+                    let sym = c.faer()?;
                     // A⁻¹ b = scale (scale A)⁻¹ b
                     let b_scale = single_rhs_scale(rhs);
                     let mut x32: Vec<f32> = rhs.iter().map(|&v| (v * b_scale) as f32).collect();
@@ -663,7 +760,8 @@ impl FaerDirect {
                     let back = scale / b_scale;
                     rhs.iter_mut().zip(&x32).for_each(|(r, &v)| *r = back * f64::from(v));
                 }
-                (Some(Symbolic::Cholesky(sym)), Numeric::Ldlt) => {
+                (Some(Symbolic::Cholesky(c)), Numeric::Ldlt) => {
+                    let sym = c.faer()?;
                     let mut buf = MemBuffer::try_new(sym.solve_in_place_scratch::<f64>(1, par)).map_err(faer_err)?;
                     let x = MatMut::from_column_major_slice_mut(rhs, n, 1);
                     LdltRef::new(sym, &self.l_values).solve_in_place_with_conj(Conj::No, x, par, MemStack::new(&mut buf));
@@ -698,7 +796,7 @@ fn single_rhs_scale(rhs: &[f64]) -> f64 {
 #[allow(clippy::too_many_arguments)]
 fn permuted_tree_solve<T: FactorReal>(
     tree: &TreeCholesky,
-    symbolic: &SymbolicSupernodalCholesky<usize>,
+    symbolic: &Supernodal,
     fwd: &[usize],
     l_values: &[T],
     rhs: &mut [f64],
@@ -790,29 +888,35 @@ fn analysis(owned: SharedPattern, symmetry: Symmetry, options: FaerDirectOptions
         .collect();
     let symbolic = match symmetry {
         Symmetry::Symmetric => {
-            let ordering_span = timeline::span("analysis: fill-reducing ordering");
-            let perm = match options.ordering {
-                FillOrdering::Amd => None,
-                FillOrdering::NestedDissection => Some(nested_dissection(a)?),
-                // without the unknowns' positions (a caller that gave none) the
-                // graph's own nested dissection
-                FillOrdering::Geometric => Some(match coordinates {
-                    Some(x) => geometric_dissection(a, x)?,
-                    None => nested_dissection(a)?,
-                }),
+            let c = match options.ordering {
+                FillOrdering::Amd => {
+                    let _symbolic_span = timeline::span("analysis: symbolic factorization (faer)");
+                    CholeskySymbolic::of_faer(faer_symbolic(a, SymmetricOrdering::Amd)?)
+                }
+                FillOrdering::NestedDissection | FillOrdering::Geometric => {
+                    let ordering_span = timeline::span("analysis: fill-reducing ordering");
+                    let graph = SupervariableGraph::of(a)?;
+                    // without the unknowns' positions (a caller that gave none) the
+                    // graph's own nested dissection
+                    let (order, what) = match (options.ordering, coordinates) {
+                        (FillOrdering::Geometric, Some(x)) => (geometric_order_of(&graph, x)?, "the geometric ordering"),
+                        _ => (nested_dissection_of(&graph)?, "METIS_NodeND"),
+                    };
+                    let perm = graph.expand(order.iter().copied(), what)?;
+                    drop(ordering_span);
+                    if options.elimination_tree {
+                        // faer's structure on the supervariables; faer's own analysis
+                        // only if an LDLᵀ needs it
+                        let _symbolic_span = timeline::span("analysis: supernodal structure");
+                        let structure = Supernodal::of_supervariables(&graph, &order);
+                        CholeskySymbolic { perm, structure: Some(structure), faer: None }
+                    } else {
+                        let _symbolic_span = timeline::span("analysis: symbolic factorization (faer)");
+                        let ordering = SymmetricOrdering::Custom(PermRef::new_checked(&perm.forward, &perm.inverse, n));
+                        CholeskySymbolic::of_faer(faer_symbolic(a, ordering)?)
+                    }
+                }
             };
-            drop(ordering_span);
-            let ordering = match &perm {
-                None => SymmetricOrdering::Amd,
-                Some(p) => SymmetricOrdering::Custom(PermRef::new_checked(&p.forward, &p.inverse, n)),
-            };
-            // Supernodal always: faer's automatic choice takes the simplicial factorization
-            // when flops / nnz(L) < 40, as on the shallow ironing's one-element-thick
-            // slab (4.5k unknowns), where the supernodal one (each node's 3 dofs a dense
-            // block at least) factors in half the time (docs/performance.md).
-            let params = CholeskySymbolicParams { supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL, ..Default::default() };
-            let _symbolic_span = timeline::span("analysis: symbolic factorization (faer)");
-            let c = factorize_symbolic_cholesky(a, Side::Lower, ordering, params).map_err(|e| LinearSolverError::Faer(format!("{e:?}")))?;
             // sized in double even for a single-precision factor: one that f32 cannot
             // hold is made in double
             crate::solver::memory::check_cholesky(c.len_val(), n, owned.compute_nnz()).map_err(LinearSolverError::TooLarge)?;
@@ -822,17 +926,12 @@ fn analysis(owned: SharedPattern, symmetry: Symmetry, options: FaerDirectOptions
     };
     let _tree_span = timeline::span("analysis: elimination-tree tasks");
     let tree = match &symbolic {
-        Symbolic::Cholesky(c) if options.elimination_tree => match c.raw() {
-            SymbolicCholeskyRaw::Supernodal(s) => Some(TreeCholesky::new(s)),
-            SymbolicCholeskyRaw::Simplicial(_) => None,
-        },
+        Symbolic::Cholesky(CholeskySymbolic { structure: Some(s), .. }) if options.elimination_tree => Some(TreeCholesky::new(s)),
         _ => None,
     };
     let widest_supernode = match &symbolic {
-        Symbolic::Cholesky(c) => match c.raw() {
-            SymbolicCholeskyRaw::Supernodal(s) => s.supernode_begin().iter().zip(s.supernode_end()).map(|(b, e)| e - b).max().unwrap_or(0),
-            SymbolicCholeskyRaw::Simplicial(_) => 1,
-        },
+        Symbolic::Cholesky(CholeskySymbolic { structure: Some(s), .. }) => s.widest(),
+        Symbolic::Cholesky(_) => 1,
         Symbolic::Lu(_) => 0,
     };
     Ok(Analysis { pattern: owned, diag_pos, symbolic, tree, widest_supernode, time: start.elapsed() })

@@ -15,12 +15,14 @@
 //! | [`interface`] | the [`LinearSolver`] trait and what it reports |
 //! | [`error`] | [`LinearSolverError`] |
 //! | [`faer_direct`] | the faer backend: ordering and symbolic factorization once, `LLᵀ` → `LDLᵀ` or `LU` per Newton iteration, the singularity check |
+//! | [`supernodal`] | the factor's supernodal structure, faer's computed on the supervariable (node) graph |
 //! | [`tree_cholesky`] | the numeric supernodal `LLᵀ`, parallel over the elimination tree, into faer's factor layout |
 //! | [`tree_solve`] | the triangular solves with that factor, parallel over the same tree |
 
 pub mod dense_kernels;
 pub mod error;
 pub mod faer_direct;
+pub mod supernodal;
 pub mod tree_cholesky;
 pub mod tree_solve;
 pub mod interface;

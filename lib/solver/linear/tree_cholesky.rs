@@ -62,7 +62,7 @@ use faer::linalg::cholesky::llt::factor::{cholesky_in_place, cholesky_in_place_s
 use faer::linalg::matmul::triangular::{self, BlockStructure};
 use faer::linalg::matmul::matmul;
 use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
-use faer::sparse::linalg::cholesky::supernodal::SymbolicSupernodalCholesky;
+use super::supernodal::Supernodal;
 use faer::sparse::SparseColMatRef;
 use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::traits::RealField;
@@ -230,7 +230,7 @@ const NONE: usize = usize::MAX;
 
 impl TreeCholesky {
     /// The schedule of `symbolic`'s numeric factorization.
-    pub fn new(symbolic: &SymbolicSupernodalCholesky<usize>) -> Self {
+    pub fn new(symbolic: &Supernodal) -> Self {
         let n_super = symbolic.n_supernodes();
         let n = symbolic.nrows();
         let (begin, end) = (symbolic.supernode_begin(), symbolic.supernode_end());
@@ -346,7 +346,7 @@ impl TreeCholesky {
     /// supernodes that met one) where a pivot is not positive.
     pub fn factor(
         &self,
-        symbolic: &SymbolicSupernodalCholesky<usize>,
+        symbolic: &Supernodal,
         a: SparseColMatRef<'_, usize, f64>,
         perm: Option<FillPermutation<'_>>,
         l_values: &mut [f64],
@@ -359,7 +359,7 @@ impl TreeCholesky {
     /// (each entry `scale · a_ij` rounded once).
     pub fn factor_scaled<T: FactorReal>(
         &self,
-        symbolic: &SymbolicSupernodalCholesky<usize>,
+        symbolic: &Supernodal,
         a: SparseColMatRef<'_, usize, f64>,
         perm: Option<FillPermutation<'_>>,
         scale: f64,
@@ -405,7 +405,7 @@ pub struct FillPermutation<'a> {
 /// What every task of one factorization shares.
 struct Context<'a, T> {
     tree: &'a TreeCholesky,
-    symbolic: &'a SymbolicSupernodalCholesky<usize>,
+    symbolic: &'a Supernodal,
     /// `A` (its entries on or below the diagonal of `P A Pᵀ` are read).
     a: SparseColMatRef<'a, usize, f64>,
     perm: Option<FillPermutation<'a>>,
@@ -644,6 +644,8 @@ pub(super) mod tests {
         pub(in crate::solver::linear) p: SymbolicSparseColMat<usize>,
         pub(in crate::solver::linear) v: Vec<f64>,
         pub(in crate::solver::linear) sym: SymbolicCholesky<usize>,
+        /// `sym`'s supernodal structure, copied.
+        structure: Supernodal,
         lower: (Vec<usize>, Vec<usize>, Vec<f64>),
         /// Factor faer's permuted lower triangle instead of `A` through `P`.
         from_permuted_copy: bool,
@@ -665,14 +667,15 @@ pub(super) mod tests {
             let used = cp[n];
             ri.truncate(used);
             val.truncate(used);
-            Self { p, v, sym, lower: (cp, ri, val), from_permuted_copy: false }
+            let structure = match sym.raw() {
+                SymbolicCholeskyRaw::Supernodal(s) => Supernodal::of_faer(s),
+                SymbolicCholeskyRaw::Simplicial(_) => panic!("a supernodal factor"),
+            };
+            Self { p, v, sym, structure, lower: (cp, ri, val), from_permuted_copy: false }
         }
 
-        pub(in crate::solver::linear) fn supernodal(&self) -> &SymbolicSupernodalCholesky<usize> {
-            match self.sym.raw() {
-                SymbolicCholeskyRaw::Supernodal(s) => s,
-                SymbolicCholeskyRaw::Simplicial(_) => panic!("a supernodal factor"),
-            }
+        pub(in crate::solver::linear) fn supernodal(&self) -> &Supernodal {
+            &self.structure
         }
 
         /// The tree factorization's values, on `threads` rayon threads.

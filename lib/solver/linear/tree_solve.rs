@@ -28,7 +28,7 @@
 
 use faer::linalg::matmul::matmul;
 use faer::linalg::triangular_solve::{solve_lower_triangular_in_place, solve_upper_triangular_in_place};
-use faer::sparse::linalg::cholesky::supernodal::SymbolicSupernodalCholesky;
+use super::supernodal::Supernodal;
 use faer::{Accum, ColMut, ColRef, MatRef, Par};
 
 use super::tree_cholesky::{FactorReal, SharedValues, TreeCholesky};
@@ -43,7 +43,7 @@ impl TreeCholesky {
     /// any factor in faer's supernodal layout of `symbolic`); `work` holds the
     /// supernodes' updates `w_s` (resized here; keep it between solves). The
     /// subtrees run on rayon's pool.
-    pub fn solve_in_place<T: FactorReal>(&self, symbolic: &SymbolicSupernodalCholesky<usize>, l_values: &[T], x: &mut [T], work: &mut Vec<T>) {
+    pub fn solve_in_place<T: FactorReal>(&self, symbolic: &Supernodal, l_values: &[T], x: &mut [T], work: &mut Vec<T>) {
         assert_eq!(l_values.len(), symbolic.len_val(), "the value array must match the symbolic factor");
         assert_eq!(x.len(), symbolic.nrows(), "the right-hand side must match the symbolic factor");
         // every entry is written (by its supernode's forward step) before it is read
@@ -88,7 +88,7 @@ impl TreeCholesky {
 /// What the tasks of one solve share.
 struct Solve<'a, T> {
     tree: &'a TreeCholesky,
-    symbolic: &'a SymbolicSupernodalCholesky<usize>,
+    symbolic: &'a Supernodal,
     l: &'a [T],
     /// The solution, written supernode by supernode (see the module's
     /// Determinism; a task writes only the rows of the supernode it solves).

@@ -58,19 +58,27 @@ const QUANTILES: [f64; 3] = [0.5, 1.0 / 3.0, 2.0 / 3.0];
 /// CSC, both triangles stored); `coordinates[j]` is the position of column `j`'s
 /// node (the first column of each supervariable is read).
 pub fn geometric_dissection(pattern: SymbolicSparseColMatRef<'_, usize>, coordinates: &[[f64; 3]]) -> Result<Permutation, LinearSolverError> {
-    let n = pattern.ncols();
+    let graph = SupervariableGraph::of(pattern)?;
+    let order = geometric_order_of(&graph, coordinates)?;
+    graph.expand(order, "the geometric ordering")
+}
+
+/// [`geometric_dissection`]'s order of the vertices of a supervariable graph
+/// (`coordinates`: each unknown's node position): `order[k]` the `k`-th to
+/// eliminate.
+pub fn geometric_order_of(graph: &SupervariableGraph, coordinates: &[[f64; 3]]) -> Result<Vec<usize>, LinearSolverError> {
+    let n = graph.start.last().copied().unwrap_or(0);
     if coordinates.len() != n {
         return Err(LinearSolverError::Faer(format!("geometric ordering: {} coordinates for {n} unknowns", coordinates.len())));
     }
-    let graph = SupervariableGraph::of(pattern)?;
     let n_super = graph.n_vertices();
     let x: Vec<[f64; 3]> = (0..n_super).map(|s| coordinates[graph.start[s]]).collect();
     if x.iter().flatten().any(|c| !c.is_finite()) {
         return Err(LinearSolverError::Faer("geometric ordering: a node coordinate is not finite".into()));
     }
-    let mut d = Dissection::new(&graph, &x);
+    let mut d = Dissection::new(graph, &x);
     d.part((0..n_super as u32).collect());
-    graph.expand(d.order.iter().map(|&s| s as usize), "the geometric ordering")
+    Ok(d.order.iter().map(|&s| s as usize).collect())
 }
 
 /// The state of one ordering: each vertex's part stamp, and the order so far.

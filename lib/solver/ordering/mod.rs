@@ -29,7 +29,7 @@ use faer::sparse::SymbolicSparseColMatRef;
 
 pub mod geometric;
 pub mod vertex_cover;
-pub use geometric::geometric_dissection;
+pub use geometric::{geometric_dissection, geometric_order_of};
 
 /// Serialises the calls into METIS (its random generator is a process global).
 static METIS_LOCK: std::sync::Mutex<()> = std::sync::Mutex::new(());
@@ -152,11 +152,22 @@ impl SupervariableGraph {
 /// Nested-dissection ordering (METIS) of a structurally symmetric pattern
 /// (square CSC, both triangles stored).
 pub fn nested_dissection(pattern: SymbolicSparseColMatRef<'_, usize>) -> Result<Permutation, LinearSolverError> {
-    let n = pattern.ncols();
-    if n == 0 {
-        return Ok(Permutation { forward: vec![], inverse: vec![] });
-    }
     let graph = SupervariableGraph::of(pattern)?;
+    let order = nested_dissection_of(&graph)?;
+    graph.expand(order, "METIS_NodeND")
+}
+
+/// [`nested_dissection`]'s order of the supervariables of `pattern`.
+pub fn nested_dissection_order(pattern: SymbolicSparseColMatRef<'_, usize>) -> Result<Vec<usize>, LinearSolverError> {
+    nested_dissection_of(&SupervariableGraph::of(pattern)?)
+}
+
+/// METIS's nested-dissection order of the vertices of a supervariable graph
+/// (each weighted by its columns): `order[k]` the `k`-th to eliminate.
+pub fn nested_dissection_of(graph: &SupervariableGraph) -> Result<Vec<usize>, LinearSolverError> {
+    if graph.n_vertices() == 0 {
+        return Ok(Vec::new());
+    }
     let start = &graph.start;
     let n_super = graph.n_vertices();
     let too_big = |what: &'static str| LinearSolverError::Faer(format!("METIS ordering: the {what} exceeds METIS's 32-bit index"));
@@ -186,9 +197,8 @@ pub fn nested_dissection(pattern: SymbolicSparseColMatRef<'_, usize>) -> Result<
     if status != metis_sys::rstatus_et_METIS_OK {
         return Err(LinearSolverError::Faer(format!("METIS_NodeND failed with status {status}")));
     }
-    // the supervariables in METIS's order, each with its columns in order
-    let order = perm.iter().map(|&s| usize::try_from(s).unwrap_or(usize::MAX));
-    graph.expand(order, "METIS_NodeND")
+    // the supervariables in METIS's order (each with its columns in order, `expand`)
+    Ok(perm.iter().map(|&s| usize::try_from(s).unwrap_or(usize::MAX)).collect())
 }
 
 /// `perm` is a permutation of `0..n` (with its inverse), and the 3 dofs of each
