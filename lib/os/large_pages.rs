@@ -5,7 +5,8 @@
 //! touches almost every page it allocates once (the sparsity pattern, the slot
 //! maps, the tangent's values, the factor, the results' buffers): at 10k unknowns
 //! 14,600 faults, about 26 ms of CPU in a 140 ms run. Blocks of at least
-//! [`THRESHOLD`] bytes are therefore mapped on their own, from a 2 MiB boundary, and
+//! [`THRESHOLD`] bytes (half a huge page) are therefore mapped on their own, from a
+//! 2 MiB boundary, and
 //! advised `MADV_HUGEPAGE` (honoured when the kernel's transparent huge pages are
 //! `madvise` or `always`); smaller ones go to the system allocator. Measured on the
 //! Parisch blocks and the crossed beams: docs/performance.md.
@@ -18,9 +19,9 @@ use std::sync::atomic::{AtomicU8, Ordering};
 
 /// A transparent huge page (x86-64): mappings start on a multiple of it.
 const HUGE: usize = 2 << 20;
-/// Blocks from this size on are mapped with huge pages advised (a smaller one
-/// cannot hold a huge page).
-pub const THRESHOLD: usize = HUGE;
+/// Blocks from this size on are mapped with huge pages advised ([`mapped_len`]:
+/// one from half a huge page on takes a whole one).
+pub const THRESHOLD: usize = HUGE / 2;
 /// The largest alignment a mapping gives by itself.
 const PAGE: usize = 4096;
 
@@ -59,12 +60,20 @@ fn mapped(size: usize, align: usize) -> bool {
     size >= THRESHOLD && align < PAGE && enabled()
 }
 
-/// The mapping's length for a block of `size` bytes: whole 4 KiB pages (the
-/// block's whole huge pages on huge pages, its tail on small ones: rounding every
-/// block up to whole huge pages cost the frictional crossed beams n = 4 17 MB of
-/// peak, a quarter, for the last huge page of each 2–6 MB block).
+/// The mapping's length for a block of `size` bytes: its whole huge pages, and a
+/// tail of at least half a huge page rounded up to a whole one, a shorter tail to
+/// whole 4 KiB pages. A huge page's first touch costs a quarter of its 512 small
+/// pages' (module documentation), so a tail of half of one or more is cheaper on
+/// one, for at most as much memory again; rounding every tail up cost the
+/// frictional crossed beams n = 4 17 MB of peak, a quarter (the last huge page of
+/// each 2–6 MB block). Measured: docs/performance.md.
 fn mapped_len(size: usize) -> usize {
-    size.div_ceil(PAGE) * PAGE
+    let whole = size / HUGE * HUGE;
+    if size - whole >= HUGE / 2 {
+        whole + HUGE
+    } else {
+        size.div_ceil(PAGE) * PAGE
+    }
 }
 
 /// A fresh anonymous mapping (zeroed) of `mapped_len(size)` bytes starting on a
@@ -215,10 +224,15 @@ mod tests {
 
     #[test]
     fn mappings_are_whole_small_pages_from_a_huge_page_boundary() {
+        // half a huge page and more: a whole one; a shorter tail: small pages
         assert_eq!(mapped_len(THRESHOLD), HUGE);
-        assert_eq!(mapped_len(THRESHOLD + 1), HUGE + PAGE);
+        assert_eq!(mapped_len(HUGE - 1), HUGE);
+        assert_eq!(mapped_len(HUGE), HUGE);
+        assert_eq!(mapped_len(HUGE + 1), HUGE + PAGE);
+        assert_eq!(mapped_len(HUGE + HUGE / 2), 2 * HUGE);
+        assert_eq!(mapped_len(3 * HUGE + 12345), 3 * HUGE + 4 * PAGE);
         let a = LargePages;
-        for size in [THRESHOLD, THRESHOLD + 1, 3 * HUGE + 12345] {
+        for size in [THRESHOLD, THRESHOLD + 1, HUGE + 1, 3 * HUGE + 12345] {
             let layout = Layout::from_size_align(size, 8).unwrap();
             let p = unsafe { a.alloc(layout) };
             assert!(!p.is_null() && p as usize % HUGE == 0, "{size} bytes at {p:?}");
