@@ -22,7 +22,7 @@ pub fn read_input(path: &Path) -> io::Result<Vec<u8>> {
 /// Write `bytes` to `path`: a regular file (or a new one) atomically, anything
 /// else in place; see [`write_atomic_with`].
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), StageError> {
-    write_atomic_with(path, |w| w.write_all(bytes))
+    write_replacing(path, true, 0, |w| w.write_all(bytes))
 }
 
 /// [`write_atomic`] without the `fsync` before the rename, for a file derived from
@@ -31,7 +31,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), StageError> {
 /// one, whole; a power loss may leave the new one empty. Saves an `fdatasync`
 /// (0.3–0.8 ms on the reference machine) per rewrite.
 pub fn write_atomic_unsynced(path: &Path, bytes: &[u8]) -> Result<(), StageError> {
-    write_replacing(path, false, |w| w.write_all(bytes))
+    write_replacing(path, false, 0, |w| w.write_all(bytes))
 }
 
 /// Where [`write_atomic_with`] puts its bytes, decided by what `path` names now.
@@ -86,11 +86,16 @@ pub fn output_kind(path: &Path) -> Result<OutputKind, StageError> {
 /// - `-`: standard output;
 /// - a directory: an error, before `f` runs.
 pub fn write_atomic_with(path: &Path, f: impl FnOnce(&mut dyn Write) -> io::Result<()>) -> Result<(), StageError> {
-    write_replacing(path, true, f)
+    write_replacing(path, true, WRITE_BUFFER, f)
 }
 
-/// [`write_atomic_with`], the temporary `fsync`ed before the rename when `sync`.
-fn write_replacing(path: &Path, sync: bool, f: impl FnOnce(&mut dyn Write) -> io::Result<()>) -> Result<(), StageError> {
+/// The write buffer of [`write_atomic_with`]'s producers, which write piece by piece.
+const WRITE_BUFFER: usize = 1 << 20;
+
+/// [`write_atomic_with`], the temporary `fsync`ed before the rename when `sync`,
+/// through a buffer of `buffer` bytes (0: bytes already whole go straight to the
+/// file, without a buffer to allocate and touch).
+fn write_replacing(path: &Path, sync: bool, buffer: usize, f: impl FnOnce(&mut dyn Write) -> io::Result<()>) -> Result<(), StageError> {
     let shown = path.display().to_string();
     let io_err = |action: &'static str| {
         let shown = shown.clone();
@@ -106,7 +111,7 @@ fn write_replacing(path: &Path, sync: bool, f: impl FnOnce(&mut dyn Write) -> io
         }
         OutputKind::Special => {
             let file = fs::OpenOptions::new().write(true).open(path).map_err(io_err("open for writing"))?;
-            let mut w = io::BufWriter::with_capacity(1 << 20, file);
+            let mut w = io::BufWriter::with_capacity(buffer, file);
             return f(&mut w).and_then(|_| w.flush()).map_err(io_err("write"));
         }
         OutputKind::Regular { target } => target,
@@ -115,7 +120,7 @@ fn write_replacing(path: &Path, sync: bool, f: impl FnOnce(&mut dyn Write) -> io
     let tmp = temp_path(&target);
     let file = fs::File::create(&tmp).map_err(io_err("create its temporary file in the same folder"))?;
     let result = (|| -> io::Result<()> {
-        let mut w = io::BufWriter::with_capacity(1 << 20, file);
+        let mut w = io::BufWriter::with_capacity(buffer, file);
         f(&mut w)?;
         let file = w.into_inner().map_err(|e| e.into_error())?;
         if sync {
