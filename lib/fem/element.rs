@@ -275,6 +275,54 @@ impl SpatialStiffness {
         }
     }
 
+    /// [`Self::add`] for an isotropic spatial tangent `c = α (1 ⊗ 1) + β 𝕀`
+    /// ([`MaterialModel::isotropic_stress_tangent`]), whose contraction with the
+    /// gradients needs no Voigt products:
+    /// K_ab[i][j] += w [α g_ai g_bj + β/2 (g_aj g_bi + δ_ij g_a · g_b)] + δ_ij w g_a · T g_b,
+    /// two products per entry instead of three and no `h` (the Parisch blocks'
+    /// element 1.8× fewer operations). The same lanes and order in every build.
+    #[inline(always)]
+    fn add_isotropic(&mut self, g: &ShapeGradients, alpha: f64, beta: f64, T: Option<&Matrix3<f64>>, w: f64) {
+        let gc: [[f64; 8]; 3] = std::array::from_fn(|l| std::array::from_fn(|a| g[(a, l)]));
+        let (wa, wh) = (w * alpha, 0.5 * w * beta);
+        // tg[k][b] = w β/2 g_bk + w (T g_b)_k: the diagonal term is Σ_k g_ak tg[k][b]
+        let mut tg = [[0.0; 8]; 3];
+        for (k, tgk) in tg.iter_mut().enumerate() {
+            for b in 0..8 {
+                tgk[b] = wh * gc[k][b];
+            }
+        }
+        if let Some(T) = T {
+            for (k, tgk) in tg.iter_mut().enumerate() {
+                let t: [f64; 3] = std::array::from_fn(|l| w * T[(k, l)]);
+                for b in 0..8 {
+                    tgk[b] += t[0] * gc[0][b] + t[1] * gc[1][b] + t[2] * gc[2][b];
+                }
+            }
+        }
+        for (b, ktb) in self.kt.iter_mut().enumerate() {
+            for (j, ktbj) in ktb.iter_mut().enumerate() {
+                let a_bj = wa * gc[j][b];
+                for (i, col) in ktbj.iter_mut().enumerate() {
+                    let h_bi = wh * gc[i][b];
+                    for a in 0..8 {
+                        col[a] += gc[i][a] * a_bj + gc[j][a] * h_bi;
+                    }
+                }
+            }
+            let t: [f64; 3] = std::array::from_fn(|k| tg[k][b]);
+            let mut s = [0.0; 8];
+            for a in 0..8 {
+                s[a] = gc[0][a] * t[0] + gc[1][a] * t[1] + gc[2][a] * t[2];
+            }
+            for (j, ktbj) in ktb.iter_mut().enumerate() {
+                for (v, sa) in ktbj[j].iter_mut().zip(&s) {
+                    *v += sa;
+                }
+            }
+        }
+    }
+
     /// Adds the upper node blocks (a ≤ b) into `k`.
     fn add_upper_to(&self, k: &mut ElementMatrix) {
         for (b, ktb) in self.kt.iter().enumerate() {
@@ -327,6 +375,12 @@ fn integrate(
         let err = |e| material_error(q, e);
         if linear {
             if k.is_some() {
+                if let Some(iso) = mat.isotropic_stress_tangent(&F) {
+                    let (sigma, alpha, beta) = iso.map_err(err)?;
+                    add_force_spatial(r, &G, &sigma, w);
+                    spatial.add_isotropic(&G, alpha, beta, None, w);
+                    continue;
+                }
                 let (sigma, c) = mat.stress_tangent(&F).map_err(err)?;
                 add_force_spatial(r, &G, &sigma, w);
                 spatial.add(&G, &c, None, w);
@@ -341,6 +395,16 @@ fn integrate(
             return Err(ElementError::Inverted { gauss_point: q, J });
         }
         let Finv = F.try_inverse().ok_or(ElementError::Inverted { gauss_point: q, J })?;
+        if k.is_some() && matches!(form, Formulation::UpdatedLagrangian) {
+            if let Some(iso) = mat.isotropic_stress_tangent(&F) {
+                let (sigma, alpha, beta) = iso.map_err(err)?;
+                let g = G * Finv;
+                let dv = w * J;
+                add_force_spatial(r, &g, &sigma, dv);
+                spatial.add_isotropic(&g, alpha, beta, Some(&sigma), dv);
+                continue;
+            }
+        }
         let (sigma, c) = if k.is_some() {
             let (s, c) = mat.stress_tangent(&F).map_err(err)?;
             (s, Some(c))
@@ -537,5 +601,28 @@ mod sparse_operator_tests {
         add_force(&mut rd, &b_linear(&g), &stress_to_voigt(&T), w);
         add_force_spatial(&mut rs, &g, &T, w);
         assert!((rd - rs).abs().max() < 1e-14 * rd.abs().max());
+    }
+
+    /// The isotropic kernel ([`SpatialStiffness::add_isotropic`]) is the general
+    /// one ([`SpatialStiffness::add`]) of `c = α (1 ⊗ 1) + β 𝕀`, with and without a
+    /// stress, to round-off (1e-14 of the entries).
+    #[test]
+    fn the_isotropic_kernel_is_the_general_one_of_its_tangent() {
+        use crate::material::{identity_outer, sym_identity};
+        let v = |i: usize| ((i * 7919 % 113) as f64 / 113.0 - 0.5) * 2.0;
+        let g = ShapeGradients::from_fn(|a, j| v(3 * a + j + 1));
+        let (alpha, beta) = (1.7, 0.6);
+        let c = identity_outer() * alpha + sym_identity() * beta;
+        let T = Matrix3::from_fn(|i, j| v(90 + i + j));
+        for stress in [None, Some(&T)] {
+            let (mut general, mut iso) = (SpatialStiffness::new(), SpatialStiffness::new());
+            general.add(&g, &c, stress, 0.37);
+            iso.add_isotropic(&g, alpha, beta, stress, 0.37);
+            let (mut kg, mut ki) = (ElementMatrix::zeros(), ElementMatrix::zeros());
+            general.add_upper_to(&mut kg);
+            iso.add_upper_to(&mut ki);
+            assert!(kg.abs().max() > 0.1);
+            assert!((kg - ki).abs().max() < 1e-14 * kg.abs().max(), "{:e}", (kg - ki).abs().max());
+        }
     }
 }

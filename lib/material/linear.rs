@@ -35,6 +35,11 @@ impl LinearElastic {
     pub fn hooke(&self) -> Tangent {
         identity_outer() * self.lambda + sym_identity() * (2.0 * self.mu)
     }
+    /// σ and the isotropic tangent's coefficients (λ, 2μ) of [`Self::hooke`].
+    #[inline]
+    pub fn isotropic_stress_tangent(&self, F: &Matrix3<f64>) -> Result<(Matrix3<f64>, f64, f64), MaterialError> {
+        Ok((self.sigma(F), self.lambda, 2.0 * self.mu))
+    }
     #[inline]
     fn sigma(&self, F: &Matrix3<f64>) -> Matrix3<f64> {
         let eps = small_strain(F);

@@ -26,6 +26,22 @@ impl MaterialModel {
     }
 }
 
+impl MaterialModel {
+    /// Cauchy stress σ and the coefficients of an isotropic spatial tangent
+    /// `c = α (1 ⊗ 1) + β 𝕀` (𝕀 the symmetric fourth-order identity), for the models
+    /// whose tangent is one (`None` otherwise: the deviatoric/volumetric
+    /// neo-Hookean's holds `b`); the element then contracts it without Voigt
+    /// products. The same σ and c as [`Material::stress_tangent`].
+    #[inline]
+    pub fn isotropic_stress_tangent(&self, F: &Matrix3<f64>) -> Option<Result<(Matrix3<f64>, f64, f64), MaterialError>> {
+        match self {
+            MaterialModel::CiarletSimo(m) => Some(m.isotropic_stress_tangent(F)),
+            MaterialModel::LinearElastic(m) => Some(m.isotropic_stress_tangent(F)),
+            MaterialModel::DevVolNeoHookean(_) => None,
+        }
+    }
+}
+
 impl From<CiarletSimo> for MaterialModel {
     fn from(m: CiarletSimo) -> Self {
         MaterialModel::CiarletSimo(m)

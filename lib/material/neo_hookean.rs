@@ -88,6 +88,14 @@ impl Material for CiarletSimo {
 }
 
 impl CiarletSimo {
+    /// σ and the isotropic tangent's coefficients (α, β) of [`Material::stress_tangent`]'s c.
+    #[inline]
+    pub fn isotropic_stress_tangent(&self, F: &Matrix3<f64>) -> Result<(Matrix3<f64>, f64, f64), MaterialError> {
+        let J = check_J(F)?;
+        let (l, m) = (self.lambda, self.mu);
+        Ok((self.sigma(F, J), l * J, (2.0 * m - l * (J * J - 1.0)) / J))
+    }
+
     #[inline]
     fn sigma(&self, F: &Matrix3<f64>, J: f64) -> Matrix3<f64> {
         let b = F * F.transpose();
