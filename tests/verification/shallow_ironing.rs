@@ -101,7 +101,7 @@ fn check(name: &str, (r, results): &(History, Results), pin: &Pin) -> (f64, f64)
     // same to 0.1 N/mm); a change of the master's geometry or of the contact element
     // moves it by several N/mm
     assert!((v / pin.v_15 - 1.0).abs() < 0.01, "{name}: V(1.5) = {v} (pinned {})", pin.v_15);
-    assert!((osc.rms / pin.v_rms - 1.0).abs() < 0.3, "{name}: V oscillation {:.3e} (pinned {:.3e})", osc.rms, pin.v_rms);
+    assert!((osc.rms / pin.v_rms - 1.0).abs() < pin.rms_band, "{name}: V oscillation {:.3e} (pinned {:.3e} ± {:.0} %)", osc.rms, pin.v_rms, 100.0 * pin.rms_band);
     assert!(its as f64 <= 1.25 * pin.newton as f64 + 2.0, "{name}: {its} Newton corrections (pinned {})", pin.newton);
     assert!(cut as f64 <= 1.25 * pin.cutbacks as f64 + 2.0, "{name}: {cut} cutbacks (pinned {})", pin.cutbacks);
     (v, h)
@@ -140,19 +140,22 @@ fn shallow_ironing_coulomb_bspline() {
 }
 
 /// Pins (2026-11-23): V(1.5) ±1 % (above); V oscillation RMS over the travel [2, 5]
-/// ±30 % (a difference of nearly equal forces, 1e-4 of V, that moves with the Newton
+/// ±30 % unless a pin says otherwise (a difference of nearly equal forces, 1e-4 of V, that moves with the Newton
 /// tolerance and the platform's rounding, but by factors with the master's
 /// smoothness); Newton corrections and cutbacks + 25 % (+2: the facet runs snap over
 /// creases, and a snap's path moves with the platform's rounding).
 struct Pin {
     v_15: f64,
     v_rms: f64,
+    /// the relative band of `v_rms` (0.3; wider where a chain's oscillation is known
+    /// to move with the last bits of its Newton path)
+    rms_band: f64,
     newton: usize,
     cutbacks: u32,
 }
 
-const PIN_FRICTIONLESS: Pin = Pin { v_15: 397.6, v_rms: 1.50e-4, newton: 1143, cutbacks: 0 };
-const PIN_COULOMB: Pin = Pin { v_15: 399.9, v_rms: 1.08e-4, newton: 1155, cutbacks: 0 };
+const PIN_FRICTIONLESS: Pin = Pin { v_15: 397.6, v_rms: 1.50e-4, rms_band: 0.3, newton: 1143, cutbacks: 0 };
+const PIN_COULOMB: Pin = Pin { v_15: 399.9, v_rms: 1.08e-4, rms_band: 0.3, newton: 1155, cutbacks: 0 };
 
 /// The facet master's chain of pipelines/shallow_ironing_frictionless.yaml (penalty,
 /// master-surface stabilisation `stabilization: 0.15`; without it the facet run
@@ -275,7 +278,7 @@ fn shallow_ironing_coulomb_facet_stabilized() {
 /// under the B-spline [2, 4] master's with the same penalty and no stabilisation
 /// (382.8; 376.3 with the same stabilisation): the penalty's penetration and the
 /// stabilisation's share of the load (docs/validation.md).
-const PIN_FACET_FRICTIONLESS: Pin = Pin { v_15: 371.50, v_rms: 3.87e-3, newton: 747, cutbacks: 0 };
+const PIN_FACET_FRICTIONLESS: Pin = Pin { v_15: 371.50, v_rms: 3.87e-3, rms_band: 0.3, newton: 747, cutbacks: 0 };
 /// With μ = 0.3, tolerances as above: V(1.5) inside the published band, 7.0 % under
 /// the B-spline [2, 4] master's (399.9; the penalty and the stabilisation, as without
 /// friction), stabilisation η = 0.2. Its 4 cutbacks before t = 1.5 make the
@@ -286,7 +289,13 @@ const PIN_FACET_FRICTIONLESS: Pin = Pin { v_15: 371.50, v_rms: 3.87e-3, newton: 
 /// from V(1.5) 371.88, oscillation 5.12e-3, 774 corrections, 4 cutbacks. Where this
 /// chain snaps over the facets' creases, and so how often it cuts back, moves with
 /// the last bits of the Newton path; the B-spline chains do not cut back at all.
-const PIN_FACET_COULOMB: Pin = Pin { v_15: 371.68, v_rms: 6.34e-3, newton: 761, cutbacks: 10 };
+/// Its oscillation, four times measured after changes that moved only round-off
+/// (the element's sums: an isotropic tangent contracted directly; the formulation;
+/// the stabilisation's step), was 3.66e-3 (2 cutbacks), 3.73e-3 (4), 5.12e-3 (4) and
+/// 6.34e-3 (10) with V(1.5) 371.70–371.88: the band is their spread, centred,
+/// 4.8e-3 ± 45 % (2.6e-3–7.0e-3), and still fails an oscillation halved or doubled
+/// (the B-spline chains', 1e-4, are 40 times smaller).
+const PIN_FACET_COULOMB: Pin = Pin { v_15: 371.68, v_rms: 4.8e-3, rms_band: 0.45, newton: 761, cutbacks: 10 };
 /// ‖f_stab‖ / ‖F_contact‖ over the sliding: measured at most 0.045 (at the slide's
 /// start, where the extrapolated pressing motion turns into sliding; ~0.02 after).
 const STAB_LIMIT: f64 = 0.07;
@@ -343,9 +352,9 @@ fn mortar_runs(cases: &[(&str, &str, &Pin, &Pin)]) {
 /// Measured (the frictionless one 2026-11-26, the frictional ones 2026-11-27, friction
 /// transferred by the mortar weights), standard multipliers, segmentation held below
 /// 1e-5.
-const PIN_MORTAR_COULOMB: Pin = Pin { v_15: 397.78, v_rms: 8.055e-4, newton: 2050, cutbacks: 0 };
-const PIN_MORTAR_SURFACE_FRICTIONLESS: Pin = Pin { v_15: 395.99, v_rms: 2.419e-4, newton: 1501, cutbacks: 0 };
-const PIN_MORTAR_SURFACE_COULOMB: Pin = Pin { v_15: 398.97, v_rms: 1.036e-4, newton: 1449, cutbacks: 0 };
+const PIN_MORTAR_COULOMB: Pin = Pin { v_15: 397.78, v_rms: 8.055e-4, rms_band: 0.3, newton: 2050, cutbacks: 0 };
+const PIN_MORTAR_SURFACE_FRICTIONLESS: Pin = Pin { v_15: 395.99, v_rms: 2.419e-4, rms_band: 0.3, newton: 1501, cutbacks: 0 };
+const PIN_MORTAR_SURFACE_COULOMB: Pin = Pin { v_15: 398.97, v_rms: 1.036e-4, rms_band: 0.3, newton: 1449, cutbacks: 0 };
 
 /// Frictionless sliding under mortar with `transfer: surface` and `uzawa_relaxation:
 /// 1.5`, to t = 1.5: the "corrections within 30 %" against the plain
@@ -414,14 +423,14 @@ fn balanced_transfer_slides_as_smoothly_as_node_to_surface() {
 
 /// Measured (2026-11-27), `transfer: balanced`: with friction, standard multipliers;
 /// frictionless, dual.
-const PIN_MORTAR_BALANCED_COULOMB: Pin = Pin { v_15: 399.02, v_rms: 1.038e-4, newton: 1458, cutbacks: 0 };
-const PIN_MORTAR_BALANCED_DUAL: Pin = Pin { v_15: 396.82, v_rms: 1.292e-4, newton: 1355, cutbacks: 0 };
+const PIN_MORTAR_BALANCED_COULOMB: Pin = Pin { v_15: 399.02, v_rms: 1.038e-4, rms_band: 0.3, newton: 1458, cutbacks: 0 };
+const PIN_MORTAR_BALANCED_DUAL: Pin = Pin { v_15: 396.82, v_rms: 1.292e-4, rms_band: 0.3, newton: 1355, cutbacks: 0 };
 
 /// Measured (2026-11-27), frictionless, `transfer: surface`, `multipliers: dual`.
-const PIN_MORTAR_SURFACE_DUAL: Pin = Pin { v_15: 396.82, v_rms: 1.292e-4, newton: 1272, cutbacks: 0 };
+const PIN_MORTAR_SURFACE_DUAL: Pin = Pin { v_15: 396.82, v_rms: 1.292e-4, rms_band: 0.3, newton: 1272, cutbacks: 0 };
 
 /// Measured (2026-11-26), frictionless, `transfer: surface`, `uzawa_relaxation: 1.5`.
-const PIN_MORTAR_SURFACE_RELAXED: Pin = Pin { v_15: 396.03, v_rms: 2.901e-4, newton: 1226, cutbacks: 0 };
+const PIN_MORTAR_SURFACE_RELAXED: Pin = Pin { v_15: 396.03, v_rms: 2.901e-4, rms_band: 0.3, newton: 1226, cutbacks: 0 };
 
 /// `uzawa_relaxation: 1.5` (docs/theory/contact.md, "Over-relaxation") against the
 /// plain update on the frictional B-spline [2, 4] chain to t = 1.2 (pressing and 2 mm
