@@ -20,7 +20,7 @@ fn compare_with(model: &str, level: &str, options: &[&str]) -> serde_yaml::Value
     let o = Command::new(python())
         .arg(repo().join("docs/scripts/ccx_compare.py"))
         // one run of each program: the answers are checked, not the times
-        .args([model, "--levels", level, "--threads", "2", "--repeat", "1", "--json"])
+        .args([model, "--levels", level, "--threads", "2", "--repeat", "1", "--repeat-short", "1", "--json"])
         .args(options)
         .arg("--out")
         .arg(out.path())
