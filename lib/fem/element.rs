@@ -261,16 +261,7 @@ impl SpatialStiffness {
                 }
             }
             if T.is_some() {
-                let t: [f64; 3] = std::array::from_fn(|k| tg[k][b]);
-                let mut s = [0.0; 8];
-                for a in 0..8 {
-                    s[a] = gc[0][a] * t[0] + gc[1][a] * t[1] + gc[2][a] * t[2];
-                }
-                for (j, ktbj) in ktb.iter_mut().enumerate() {
-                    for (v, sa) in ktbj[j].iter_mut().zip(&s) {
-                        *v += sa;
-                    }
-                }
+                add_diagonal_term(ktb, &gc, &tg, b);
             }
         }
     }
@@ -310,16 +301,7 @@ impl SpatialStiffness {
                     }
                 }
             }
-            let t: [f64; 3] = std::array::from_fn(|k| tg[k][b]);
-            let mut s = [0.0; 8];
-            for a in 0..8 {
-                s[a] = gc[0][a] * t[0] + gc[1][a] * t[1] + gc[2][a] * t[2];
-            }
-            for (j, ktbj) in ktb.iter_mut().enumerate() {
-                for (v, sa) in ktbj[j].iter_mut().zip(&s) {
-                    *v += sa;
-                }
-            }
+            add_diagonal_term(ktb, &gc, &tg, b);
         }
     }
 
@@ -333,6 +315,23 @@ impl SpatialStiffness {
                     }
                 }
             }
+        }
+    }
+}
+
+/// The diagonal term of the column node `b`'s blocks, K_ab[j][j] += s_ab with
+/// s_ab = Σ_k g_ak tg[k][b] (`gc[k][a]` = g_ak), in [`SpatialStiffness`]'s
+/// layout (`ktb[j][i][a]` = K_ab[i][j]).
+#[inline(always)]
+fn add_diagonal_term(ktb: &mut [[[f64; 8]; 3]; 3], gc: &[[f64; 8]; 3], tg: &[[f64; 8]; 3], b: usize) {
+    let t: [f64; 3] = std::array::from_fn(|k| tg[k][b]);
+    let mut s = [0.0; 8];
+    for a in 0..8 {
+        s[a] = gc[0][a] * t[0] + gc[1][a] * t[1] + gc[2][a] * t[2];
+    }
+    for (j, ktbj) in ktb.iter_mut().enumerate() {
+        for (v, sa) in ktbj[j].iter_mut().zip(&s) {
+            *v += sa;
         }
     }
 }

@@ -187,6 +187,13 @@ impl CholeskySymbolic {
         }
     }
 
+    /// The dof of `A` whose pivot faer reports failed at `index`: faer 0.24 counts
+    /// from 1 in the simplicial path (`index: k + 1`) and from 0 in the supernodal one.
+    fn dof_of_failed_pivot(&self, index: usize) -> usize {
+        let k = if self.structure.is_none() { index.saturating_sub(1) } else { index };
+        self.perm.forward[k]
+    }
+
     /// faer's symbolic factorization, if made.
     fn faer(&self) -> Result<&SymbolicCholesky<usize>, LinearSolverError> {
         self.faer.as_ref().ok_or(LinearSolverError::Order("a faer factorization", "its symbolic analysis"))
@@ -364,11 +371,6 @@ impl FaerDirect {
             return Err(LinearSolverError::Order("factor", "analyse"));
         };
         let a = SparseColMatRef::new((**pattern).as_ref(), values);
-        // faer 0.24 reports failed pivots 1-based in the simplicial path
-        // (`index: k + 1`) and 0-based in the supernodal one.
-        let simplicial = sym.structure.is_none();
-        let forward = &sym.perm.forward;
-        let failed = |index: usize| forward[if simplicial { index.saturating_sub(1) } else { index }];
 
         let mut method = Factorization::Ldlt;
         let tree = match (&self.tree, &sym.structure) {
@@ -391,7 +393,7 @@ impl FaerDirect {
                             self.l_values32 = vec![0.0; s.len_val()];
                         }
                         let factored = tree.factor_scaled(s, a, perm, scale, &mut self.l_values32, dense_par).is_ok();
-                        if factored && single_pivots_hold(s, &self.l_values32, values, &self.diag_pos, scale, |j| forward[j]) {
+                        if factored && single_pivots_hold(s, &self.l_values32, values, &self.diag_pos, scale, |j| sym.perm.forward[j]) {
                             return Ok(Numeric::LltSingle { scale });
                         }
                     }
@@ -423,7 +425,7 @@ impl FaerDirect {
                 Ok(()) => method = Factorization::Llt,
                 Err(LltError::NonPositivePivot { index }) => {
                     if strategy == SymmetricStrategy::Llt {
-                        return Err(LinearSolverError::NotPositiveDefinite { dof: failed(index) });
+                        return Err(LinearSolverError::NotPositiveDefinite { dof: sym.dof_of_failed_pivot(index) });
                     }
                 }
             }
@@ -436,8 +438,6 @@ impl FaerDirect {
             };
             let a = SparseColMatRef::new((**pattern).as_ref(), values);
             let faer = sym.faer()?;
-            let forward = &sym.perm.forward;
-            let failed = |index: usize| forward[if simplicial { index.saturating_sub(1) } else { index }];
             self.l_values.resize(faer.len_val(), 0.0);
             let mut buf = MemBuffer::try_new(faer.factorize_numeric_ldlt_scratch::<f64>(par, Default::default()))
                 .map_err(|e| LinearSolverError::Faer(format!("{e:?}")))?;
@@ -451,7 +451,7 @@ impl FaerDirect {
                 Default::default(),
             );
             if let Err(faer::linalg::cholesky::ldlt::factor::LdltError::ZeroPivot { index }) = ldlt {
-                return Err(LinearSolverError::Singular { dof: Some(failed(index)) });
+                return Err(LinearSolverError::Singular { dof: Some(sym.dof_of_failed_pivot(index)) });
             }
         }
         let Some(Symbolic::Cholesky(sym)) = &self.symbolic else {

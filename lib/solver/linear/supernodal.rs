@@ -90,6 +90,21 @@ impl Supernodal {
         &self.rows
     }
 
+    /// The columns of supernode `s`.
+    pub fn columns(&self, s: usize) -> std::ops::Range<usize> {
+        self.begin[s]..self.begin[s + 1]
+    }
+
+    /// The rows of supernode `s` below its columns, sorted.
+    pub fn rows_below(&self, s: usize) -> &[usize] {
+        &self.rows[self.row_ptr[s]..self.row_ptr[s + 1]]
+    }
+
+    /// Where supernode `s`'s block lies in the value array.
+    pub fn block(&self, s: usize) -> std::ops::Range<usize> {
+        self.val_ptr[s]..self.val_ptr[s + 1]
+    }
+
     /// Entries of the value array.
     pub fn len_val(&self) -> usize {
         self.val_ptr.last().copied().unwrap_or(0)

@@ -457,18 +457,14 @@ impl<T: FactorReal> Context<'_, T> {
     #[allow(clippy::too_many_arguments)]
     fn update(&self, s: usize, d: usize, cols: std::ops::Range<usize>, ls_cols: SharedValues<T>, local: &[usize], buffer: &mut Vec<T>, map: &mut Vec<usize>, par: Par) {
         let sym = self.symbolic;
-        let (begin, end) = (sym.supernode_begin(), sym.supernode_end());
-        let row_ptr = sym.col_ptr_for_row_idx();
-        let val_ptr = sym.col_ptr_for_val();
-        let rows = sym.row_idx();
-        let (s0, s1) = (begin[s], end[s]);
+        let std::ops::Range { start: s0, end: s1 } = sym.columns(s);
         let s_nrows = ls_cols.len / (s1 - s0);
-        let (d0, d1) = (begin[d], end[d]);
-        let d_ncols = d1 - d0;
-        let d_pattern = &rows[row_ptr[d]..row_ptr[d + 1]];
+        let d_ncols = sym.columns(d).len();
+        let d_pattern = sym.rows_below(d);
         let d_nrows = d_ncols + d_pattern.len();
+        let d_block = sym.block(d);
         // SAFETY: `d` is a finished descendant of `s`: read only.
-        let ld = unsafe { self.values.slice(val_ptr[d], val_ptr[d + 1] - val_ptr[d]) };
+        let ld = unsafe { self.values.slice(d_block.start, d_block.len()) };
         let ld = MatRef::from_column_major_slice(ld, d_nrows, d_ncols);
         let p0 = d_pattern.partition_point(|&r| r < s0);
         let mid = d_pattern[p0..].partition_point(|&r| r < s1);
@@ -534,16 +530,13 @@ impl<T: FactorReal> Context<'_, T> {
     /// Steps 1–3 of the module's algorithm for supernode `s`.
     fn supernode(&self, s: usize, par: Par) {
         let sym = self.symbolic;
-        let (begin, end) = (sym.supernode_begin(), sym.supernode_end());
-        let row_ptr = sym.col_ptr_for_row_idx();
-        let val_ptr = sym.col_ptr_for_val();
-        let rows = sym.row_idx();
-        let (s0, s1) = (begin[s], end[s]);
-        let s_pattern = &rows[row_ptr[s]..row_ptr[s + 1]];
+        let std::ops::Range { start: s0, end: s1 } = sym.columns(s);
+        let s_pattern = sym.rows_below(s);
         let s_ncols = s1 - s0;
         let s_nrows = s_ncols + s_pattern.len();
+        let s_block = sym.block(s);
         // SAFETY: block `s` is written by this task only; see the module's Safety.
-        let ls_slice = unsafe { self.values.slice_mut(val_ptr[s], val_ptr[s + 1] - val_ptr[s]) };
+        let ls_slice = unsafe { self.values.slice_mut(s_block.start, s_block.len()) };
         ls_slice.fill(T::of_f64(0.0));
         let mut ls = MatMut::from_column_major_slice_mut(ls_slice, s_nrows, s_ncols);
         let mut scratch = SCRATCH.with(Cell::take).unwrap_or_default();
