@@ -22,7 +22,7 @@ use super::restart::factors_done;
 use crate::assembly::DOFS_PER_NODE;
 use crate::fem::element::hex8_min_jacobian;
 use crate::format::scres::{Increment, IncrementInfo, Reaction, Results, ResultsFile, RunStatus};
-use crate::format::stage::{write_atomic_unsynced, StageError};
+use crate::format::stage::{prepare_unsynced, write_atomic_unsynced, Prepared, StageError};
 
 /// The solve stopped.
 #[derive(Debug, thiserror::Error)]
@@ -404,25 +404,51 @@ struct WrittenCsvs {
 }
 
 /// Bring the results file up to date (append what converged since) and rewrite the
-/// two CSV histories where they changed.
+/// two CSV histories where they changed. The histories, derived from the results
+/// file, are renamed into place unsynced and never before it is synced: they are
+/// prepared (written to their temporaries) on a thread of their own while the
+/// results file is written and synced, and committed after (the Parisch r = 4: the
+/// fdatasync 1.5–3 ms, the two histories' temporaries 1–2 ms beside it).
 fn write(file: &mut ResultsFile, written: &mut WrittenCsvs, results: &Results, out: &Outputs, log: &SolveLog) -> Result<(), StageError> {
     let _span = timeline::span("write results and histories");
-    file.sync(results)?;
     if !out.writer {
-        return Ok(());
+        return file.sync(results);
     }
-    let rewrite = |path: Option<&Path>, text: &str, last: &mut Option<String>| -> Result<(), StageError> {
-        if let Some(path) = path {
-            if last.as_deref() != Some(text) {
-                // derived from the results file (synced above): renamed into place unsynced
-                write_atomic_unsynced(path, text.as_bytes())?;
-                *last = Some(text.to_owned());
-            }
-        }
-        Ok(())
+    let convergence_text = log.csv();
+    let forces_text = out.forces_csv.map(|_| forces_csv(results));
+    let convergence = out.csv.filter(|_| written.convergence.as_deref() != Some(convergence_text));
+    let forces = out.forces_csv.filter(|_| written.forces != forces_text);
+    if convergence.is_none() && forces.is_none() {
+        return file.sync(results);
+    }
+    let prepare = || -> Result<(Option<Prepared>, Option<Prepared>), StageError> {
+        let _span = timeline::span("write: the histories' temporaries");
+        let c = convergence.map(|path| prepare_unsynced(path, convergence_text.as_bytes())).transpose()?;
+        let f = forces.map(|path| prepare_unsynced(path, forces_text.as_deref().unwrap_or_default().as_bytes())).transpose()?;
+        Ok((c, f))
     };
-    rewrite(out.csv, log.csv(), &mut written.convergence)?;
-    rewrite(out.forces_csv, &forces_csv(results), &mut written.forces)?;
+    let (synced, prepared) = std::thread::scope(|scope| match std::thread::Builder::new().name("sc-histories".into()).spawn_scoped(scope, prepare) {
+        Ok(side) => {
+            let synced = file.sync(results);
+            (synced, side.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic)))
+        }
+        // no thread to be had: one after the other
+        Err(_) => {
+            let synced = file.sync(results);
+            (synced, prepare())
+        }
+    });
+    // a failed results write drops the prepared histories (their temporaries removed)
+    synced?;
+    let (c, f) = prepared?;
+    if let Some(c) = c {
+        c.commit()?;
+        written.convergence = Some(convergence_text.to_owned());
+    }
+    if let Some(f) = f {
+        f.commit()?;
+        written.forces = forces_text;
+    }
     Ok(())
 }
 

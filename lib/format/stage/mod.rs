@@ -40,7 +40,7 @@ pub mod record;
 pub mod writer;
 
 pub use error::StageError;
-pub use files::{output_kind, read_input, resolve, temp_path, write_atomic, write_atomic_unsynced, write_atomic_with, OutputKind};
+pub use files::{output_kind, read_input, resolve, temp_path, write_atomic, write_atomic_unsynced, write_atomic_with, prepare_unsynced, OutputKind, Prepared};
 pub use reader::StageFile;
 pub use record::{Array, ArrayData, Dtype};
 pub use writer::{SegmentEnd, StageWriter};
