@@ -799,9 +799,10 @@ def run_with_peak(cmd, cwd, env, stdout):
     the peak is the command's; it adds about 1 ms to the wall time. Without GNU time
     (Debian's `time` package) the inherited bound is returned, exact = False."""
     import tempfile
-    t0 = time.perf_counter()
     if GNU_TIME:
         with tempfile.NamedTemporaryFile("r", suffix=".peak") as peak:
+            # the clock starts once GNU time's output file exists (not the programs' time)
+            t0 = time.perf_counter()
             p = subprocess.Popen([GNU_TIME, "-f", "%M", "-o", peak.name, *cmd], cwd=cwd, env=env, stdout=stdout, stderr=subprocess.STDOUT)
             p.wait()
             wall = time.perf_counter() - t0
@@ -812,6 +813,7 @@ def run_with_peak(cmd, cwd, env, stdout):
             except (IndexError, ValueError):
                 kb = float("nan")
         return p.returncode, wall, kb / 1024.0, True
+    t0 = time.perf_counter()
     p = subprocess.Popen(cmd, cwd=cwd, env=env, stdout=stdout, stderr=subprocess.STDOUT)
     _, status, usage = os.wait4(p.pid, 0)
     wall = time.perf_counter() - t0
