@@ -75,22 +75,7 @@ impl Drop for Prepared {
 /// `auto_da_alloc` flushes a file renamed over another: 1.3 ms on the reference
 /// machine, inside the rename).
 pub fn prepare_unsynced(path: &Path, bytes: &[u8]) -> Result<Prepared, StageError> {
-    let shown = path.display().to_string();
-    let target = match output_kind(path)? {
-        OutputKind::Regular { target } => target,
-        _ => {
-            write_replacing(path, false, 0, |w| w.write_all(bytes))?;
-            return Ok(Prepared { pending: None });
-        }
-    };
-    remove_stale_temporaries(&target);
-    let tmp = temp_path(&target);
-    let mut file = fs::File::create(&tmp).map_err(|source| StageError::Io { path: shown.clone(), action: "create its temporary file in the same folder", source })?;
-    // from here on the temporary is the Prepared's: an error drops (removes) it
-    let prepared = Prepared { pending: Some((tmp, target, shown.clone())) };
-    file.write_all(bytes).map_err(|source| StageError::Io { path: shown, action: "write", source })?;
-    start_write_back(&file);
-    Ok(prepared)
+    prepare(path, false, 0, |w| w.write_all(bytes))
 }
 
 /// Ask the kernel to start writing `file`'s dirty pages out, without waiting (a
@@ -168,6 +153,13 @@ const WRITE_BUFFER: usize = 1 << 20;
 /// through a buffer of `buffer` bytes (0: bytes already whole go straight to the
 /// file, without a buffer to allocate and touch).
 fn write_replacing(path: &Path, sync: bool, buffer: usize, f: impl FnOnce(&mut dyn Write) -> io::Result<()>) -> Result<(), StageError> {
+    prepare(path, sync, buffer, f)?.commit()
+}
+
+/// [`write_replacing`] up to the rename: standard output, a device or a FIFO written
+/// in place at once (nothing left to commit); a regular file's bytes in its
+/// temporary, `fsync`ed when `sync`, else their write-back started.
+fn prepare(path: &Path, sync: bool, buffer: usize, f: impl FnOnce(&mut dyn Write) -> io::Result<()>) -> Result<Prepared, StageError> {
     let shown = path.display().to_string();
     let io_err = |action: &'static str| {
         let shown = shown.clone();
@@ -179,35 +171,34 @@ fn write_replacing(path: &Path, sync: bool, buffer: usize, f: impl FnOnce(&mut d
             f(&mut buf).map_err(io_err("produce"))?;
             let mut out = io::stdout().lock();
             out.write_all(&buf).and_then(|_| out.flush()).map_err(io_err("write to standard output"))?;
-            return Ok(());
+            return Ok(Prepared { pending: None });
         }
         OutputKind::Special => {
             let file = fs::OpenOptions::new().write(true).open(path).map_err(io_err("open for writing"))?;
             let mut w = io::BufWriter::with_capacity(buffer, file);
-            return f(&mut w).and_then(|_| w.flush()).map_err(io_err("write"));
+            f(&mut w).and_then(|_| w.flush()).map_err(io_err("write"))?;
+            return Ok(Prepared { pending: None });
         }
         OutputKind::Regular { target } => target,
     };
     remove_stale_temporaries(&target);
     let tmp = temp_path(&target);
     let file = fs::File::create(&tmp).map_err(io_err("create its temporary file in the same folder"))?;
-    let result = (|| -> io::Result<()> {
-        let mut w = io::BufWriter::with_capacity(buffer, file);
-        f(&mut w)?;
-        let file = w.into_inner().map_err(|e| e.into_error())?;
-        if sync {
-            file.sync_data()?;
-        }
-        Ok(())
-    })();
-    if let Err(e) = result {
-        let _ = fs::remove_file(&tmp);
-        return Err(StageError::Io { path: shown, action: "write", source: e });
-    }
-    fs::rename(&tmp, &target).map_err(|e| {
-        let _ = fs::remove_file(&tmp);
-        StageError::Io { path: shown, action: "rename the temporary file onto", source: e }
-    })
+    // from here on the temporary is the Prepared's: an error drops (removes) it
+    let prepared = Prepared { pending: Some((tmp, target, shown.clone())) };
+    let mut w = io::BufWriter::with_capacity(buffer, file);
+    f(&mut w)
+        .and_then(|_| w.into_inner().map_err(|e| e.into_error()))
+        .and_then(|file| {
+            if sync {
+                file.sync_data()
+            } else {
+                start_write_back(&file);
+                Ok(())
+            }
+        })
+        .map_err(io_err("write"))?;
+    Ok(prepared)
 }
 
 /// Remove the temporaries of `target` (`.name.<pid>.tmp`) that a killed writer left:
