@@ -43,6 +43,8 @@ fn main() -> ExitCode {
             return ExitCode::from(splinecontact::stages::exit_code::BAD_INPUT);
         }
     }
+    // this thread works in rayon's parallel phases itself (lib/os/worker_pool.rs)
+    splinecontact::os::worker_pool::join_as_worker();
     let quiet = args.quiet;
     let mut log = |line: &str| {
         if !quiet {

@@ -130,6 +130,8 @@ fn main() -> ExitCode {
             return ExitCode::from(1);
         }
     };
+    // this thread works in rayon's parallel phases itself (lib/os/worker_pool.rs)
+    splinecontact::os::worker_pool::join_as_worker();
     let code = run(args, rank);
     ranks::finish();
     if rank == 0 {

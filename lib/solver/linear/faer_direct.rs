@@ -564,27 +564,19 @@ impl LinearSolver for FaerDirect {
         }
         let options = self.options;
         let coordinates = self.coordinates.clone();
-        if rayon::current_thread_index().is_none() {
-            // a task of rayon's pool: while it runs, the caller's parallel work
-            // (the first assembly) goes to the other workers, and the cores hold as
-            // many threads as they have (a thread of its own made three on two).
-            // Not from inside the pool: a worker that blocked on the task could hold
-            // up the only one that would run it.
-            let (tx, rx) = std::sync::mpsc::sync_channel(1);
-            rayon::spawn(move || {
-                let done = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| analysis(owned, symmetry, options, coordinates.as_deref())))
-                    .unwrap_or_else(|_| Err(LinearSolverError::Faer("the analysis panicked".into())));
-                let _ = tx.send(done);
-            });
-            self.pending = Some(PendingAnalysis::Pool(rx));
-            return Ok(());
-        }
-        let for_thread = Arc::clone(&owned);
-        match std::thread::Builder::new().name("sc-analysis".into()).spawn(move || analysis(for_thread, symmetry, options, coordinates.as_deref())) {
-            Ok(handle) => self.pending = Some(PendingAnalysis::Thread(handle)),
-            // no thread to be had: the analysis here
-            Err(_) => self.analyse_here(owned, symmetry)?,
-        }
+        // a task of rayon's pool: while it runs, the caller's parallel work (the
+        // first assembly) goes to the other workers, and the cores hold as many
+        // threads as they have (a thread of its own made three on two). A caller
+        // that is a worker itself (the main thread: lib/os/worker_pool.rs) waits for
+        // it by yielding to the pool first (`PendingAnalysis::wait`), so that the
+        // task runs even when no other worker is free to take it.
+        let (tx, rx) = std::sync::mpsc::sync_channel(1);
+        rayon::spawn(move || {
+            let done = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| analysis(owned, symmetry, options, coordinates.as_deref())))
+                .unwrap_or_else(|_| Err(LinearSolverError::Faer("the analysis panicked".into())));
+            let _ = tx.send(done);
+        });
+        self.pending = Some(PendingAnalysis(rx));
         Ok(())
     }
 
@@ -659,16 +651,27 @@ impl LinearSolver for FaerDirect {
 
 /// An analysis running beside its caller: a task of rayon's pool, or (from inside
 /// the pool) a thread of its own.
-enum PendingAnalysis {
-    Pool(std::sync::mpsc::Receiver<Result<Analysis, LinearSolverError>>),
-    Thread(std::thread::JoinHandle<Result<Analysis, LinearSolverError>>),
-}
+/// The background analysis' result, to come from its task in rayon's pool.
+struct PendingAnalysis(std::sync::mpsc::Receiver<Result<Analysis, LinearSolverError>>);
 
 impl PendingAnalysis {
+    /// The analysis' result. A worker of the pool runs what the pool has queued
+    /// while the result is not there (the analysis itself, if no other worker took
+    /// it), and blocks only once the pool has nothing left to run: the task is then
+    /// running elsewhere, or done.
     fn wait(self) -> Result<Analysis, LinearSolverError> {
-        match self {
-            Self::Pool(rx) => rx.recv().map_err(|_| LinearSolverError::Faer("the analysis task ended without a result".into()))?,
-            Self::Thread(handle) => handle.join().map_err(|_| LinearSolverError::Faer("the analysis thread panicked".into()))?,
+        use std::sync::mpsc::TryRecvError;
+        let ended = || LinearSolverError::Faer("the analysis task ended without a result".into());
+        loop {
+            match self.0.try_recv() {
+                Ok(done) => return done,
+                Err(TryRecvError::Disconnected) => return Err(ended()),
+                Err(TryRecvError::Empty) => {
+                    if rayon::yield_now() != Some(rayon::Yield::Executed) {
+                        return self.0.recv().map_err(|_| ended())?;
+                    }
+                }
+            }
         }
     }
 }
