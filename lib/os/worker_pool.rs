@@ -10,8 +10,8 @@
 //! thread is started, the main thread works on its own parallel phases at once and
 //! runs no sleep/wake cycle of its own. Measured on the Parisch blocks r = 4 (3,238
 //! unknowns, whole process, paired medians against the pool of two workers): A/B
-//! wall 0.88–0.95 over 41–51 pairs, r = 1 0.85, the frictional crossed beams n = 4
-//! 0.93; r = 8 the same within the noise (docs/performance.md).
+//! wall 0.84 and 0.87 over 51 pairs, r = 1 0.84, the frictional crossed beams n = 4
+//! 0.94; r = 8 1.00 (docs/performance.md).
 //!
 //! A worker 0 of this kind runs pool jobs only while it waits inside rayon (a
 //! `join`, a parallel iterator, a scope) or when it yields to the pool: code that

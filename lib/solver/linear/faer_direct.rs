@@ -649,8 +649,6 @@ impl LinearSolver for FaerDirect {
     }
 }
 
-/// An analysis running beside its caller: a task of rayon's pool, or (from inside
-/// the pool) a thread of its own.
 /// The background analysis' result, to come from its task in rayon's pool.
 struct PendingAnalysis(std::sync::mpsc::Receiver<Result<Analysis, LinearSolverError>>);
 

@@ -296,8 +296,8 @@ fn the_elimination_tree_factor_is_faers_own_bit_for_bit_with_sequential_kernels(
 
 /// `analyse_in_background` leaves what `analyse` leaves: on 2 rayon threads the
 /// analysis is a task of the pool (pending until `factor` waits for it), from inside
-/// the pool or outside it, on one in place, and the factor is the same, bit for bit, with the analysis counted
-/// once. A pattern analysed anew while the background analysis still runs waits for
+/// the pool or outside it, on one in place, and the factor is the same, bit for bit,
+/// with the analysis counted once. A pattern analysed anew while the background analysis still runs waits for
 /// it and drops it. (Its failure, a factor too large for the memory, reaches the
 /// user as the setup error it was before: `cli::solve`,
 /// `a_model_too_large_for_memory_fails_before_factorization_with_an_estimate`.)
