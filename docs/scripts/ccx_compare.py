@@ -308,17 +308,19 @@ def run_level(model, spec, n, a, out_root):
 
 
 def table(rows):
-    head = "| level | DOFs | ccx s | ours s | speed-up | ccx RSS MB | ours RSS MB | Newton its ccx / ours | max|u| ccx / ours | reaction z ccx / ours | peak p ccx / ours |"
-    out = [head, "|" + "---|" * 11]
+    head = "| level | DOFs | ccx s | ours s | speed-up | ccx RSS MB | ours RSS MB | Newton its ccx / ours | max|u| ccx / ours | reaction z ccx / ours | peak p ccx / ours | rel. diff. max|u| / reaction z |"
+    out = [head, "|" + "---|" * 12]
     for r in rows:
         o, c = r.get("ours", {}), r.get("ccx", {})
         f = lambda d, k, fmt="%.4g": (fmt % d[k]) if d.get(k) is not None else "–"
-        rz = lambda d: ("%.5g" % d["reaction"][2]) if d.get("reaction") else "–"
-        out.append("| %d | %s | %s | %s | %s | %s | %s | %s / %s | %s / %s | %s / %s | %s / %s |" % (
+        rz = lambda d: ("%.7g" % d["reaction"][2]) if d.get("reaction") else "–"
+        a = r.get("agreement")
+        agree = ("%.1e / %.1e" % (a["max_u"], a["reaction_z"])) if a else "–"
+        out.append("| %d | %s | %s | %s | %s | %s | %s | %s / %s | %s / %s | %s / %s | %s / %s | %s |" % (
             r["level"], f"{r['dofs']:,}" if r.get("dofs") else "–", f(c, "wall_s", "%.3g"), f(o, "wall_s", "%.3g"),
             ("%.1f×" % r["speedup"]) if r.get("speedup") else "–", f(c, "peak_rss_mb", "%.0f"), f(o, "peak_rss_mb", "%.0f"),
             f(c, "newton_iterations", "%d"), f(o, "newton_iterations", "%d"), f(c, "max_u", "%.6g"), f(o, "max_u", "%.6g"),
-            rz(c), rz(o), f(c, "peak_pressure", "%.4g"), f(o, "peak_pressure", "%.4g")))
+            rz(c), rz(o), f(c, "peak_pressure", "%.4g"), f(o, "peak_pressure", "%.4g"), agree))
     return "\n".join(out)
 
 
