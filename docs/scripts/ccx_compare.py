@@ -308,7 +308,7 @@ def run_level(model, spec, n, a, out_root):
 
 
 def table(rows):
-    head = "| level | DOFs | ccx s | ours s | speed-up | ccx RSS MB | ours RSS MB | Newton its ccx / ours | max|u| ccx / ours | reaction z ccx / ours | peak p ccx / ours | rel. diff. max|u| / reaction z |"
+    head = "| level | DOFs | ccx s | ours s | speed-up | ccx RSS MB | ours RSS MB | Newton its ccx / ours | max\\|u\\| ccx / ours | reaction z ccx / ours | peak p ccx / ours | rel. diff. max\\|u\\| / reaction z |"
     out = [head, "|" + "---|" * 12]
     for r in rows:
         o, c = r.get("ours", {}), r.get("ccx", {})
