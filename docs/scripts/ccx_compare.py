@@ -10,11 +10,12 @@ For each refinement level of a model:
   4. run `sc-solve` and `ccx`, each as a whole process given the same threads
      (RAYON_NUM_THREADS for ours; OMP_NUM_THREADS and CCX_NPROC_EQUATION_SOLVER for
      ccx), and read each one's wall time and peak RSS (GNU time's %M: wait4 on a
-     child of this script would start at the script's own peak); each program runs
-     --repeat times (3) while its runs take under --repeat-below seconds (20),
-     --repeat-short times (11) while they take under --short-below seconds (1), and
-     the median wall time is reported (a first run after the meshing and tagging
-     took up to 1.8 times the next ones, for either program), the largest peak;
+     child of this script would start at the script's own peak); the two programs
+     run in turn (ours, ccx, ccx, ours, ours, ccx, ...: a slow minute of the machine
+     falls on both, and each follows the other as often as itself), each --repeat times (3) while its runs take under --repeat-below seconds
+     (20), --repeat-short times (11) while they take under --short-below seconds (1),
+     and each one's median wall time is reported (a first run after the meshing and
+     tagging took up to 1.8 times the next ones, for either program), the largest peak;
   5. export our result and compare: the largest |u|, the support reaction, the
      total contact normal force and the peak contact pressure, and the Newton
      iterations of both.
@@ -99,21 +100,33 @@ def run_measured(cmd, cwd, env, log_path):
     return rc, wall, peak_mb
 
 
-def repeated(run, a):
-    """Call `run()` -> (result, ok, wall seconds) up to --repeat times while each
-    call took under --repeat-below seconds and succeeded, and up to --repeat-short
-    times while each took under --short-below seconds (both programs are measured
-    alike); (the last result, every wall time). A run of tens of milliseconds on a
-    shared virtual machine moves by a quarter and more from one second to the next
-    (the Parisch r = 4 through this script's own path: 27-73 ms in 15 runs in a
-    row); three of them give no stable median, eleven do."""
-    walls = []
-    while True:
-        result, ok, wall = run()
-        walls.append(wall)
-        limit = a.repeat_short if max(walls) < a.short_below else a.repeat
-        if not ok or len(walls) >= limit or max(walls) >= a.repeat_below:
-            return result, walls
+def interleaved(runs, a):
+    """Call each `run()` -> (result, ok, wall seconds) in turn, each one up to
+    --repeat times while its calls took under --repeat-below seconds and succeeded,
+    and up to --repeat-short times while each took under --short-below seconds (both
+    programs are measured alike); [(its last result, its wall times)] in the order of
+    `runs`. A run of tens of milliseconds on a shared virtual machine moves by a
+    quarter and more from one second to the next (the Parisch r = 4 through this
+    script's own path: 27-73 ms in 15 runs in a row); three of them give no stable
+    median, eleven do. Taken in turn, the two programs see the same minutes: a slow
+    spell of the machine falls on both medians, not on whichever program ran during
+    it. The turns go A B, B A, A B, ... (A B B A A B ...): each program follows the
+    other as often as itself, so what one run leaves behind (the other program's
+    load on the shared host, its pages, its files) weighs on both alike."""
+    state = [dict(result=None, walls=[], done=False) for _ in runs]
+    turn = 0
+    while not all(st["done"] for st in state):
+        order = list(zip(runs, state))
+        for run, st in order if turn % 2 == 0 else reversed(order):
+            if st["done"]:
+                continue
+            st["result"], ok, wall = run()
+            st["walls"].append(wall)
+            walls = st["walls"]
+            limit = a.repeat_short if max(walls) < a.short_below else a.repeat
+            st["done"] = not ok or len(walls) >= limit or max(walls) >= a.repeat_below
+        turn += 1
+    return [(st["result"], st["walls"]) for st in state]
 
 
 def gmsh_exe():
@@ -232,15 +245,46 @@ def run_level(model, spec, n, a, out_root):
         # Open MPI refuses root unless told
         env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
         cmd = ["mpirun", "-np", str(a.mpi_ranks), "--oversubscribe", *cmd]
-    peaks = []
+    our_peaks = []
 
     def ours_once():
         rc, wall, peak = run_measured(cmd, level_dir, env, level_dir / (name + ".solve.log"))
-        peaks.append(peak or 0.0)
+        our_peaks.append(peak or 0.0)
         return rc, rc == 0, wall
 
-    rc, walls = repeated(ours_once, a)
-    wall, rss = statistics.median(walls), max(peaks)
+    runs = [ours_once]
+    if not a.no_ccx:
+        # ccx's deck, from the same .msh (not timed, as our import and tag are not)
+        P = deck.resolve_pipeline(pipeline, 0, msh)
+        P["options"] = " --msh %s" % msh.name + (" --contact surface" if a.contact == "surface" else "")
+        mesh = deck.read_mesh(P["msh"])
+        text, cmodel = deck.build_deck(P, mesh, ran=a.ccx_ran if a.ccx_ran is not None else spec.get("ccx_ran"), ctype=a.contact)
+        ccx_dir = level_dir / "ccx"
+        ccx_dir.mkdir(exist_ok=True)
+        (ccx_dir / (P["name"] + ".inp")).write_text(text)
+        ccx_peaks = []
+
+        def ccx_once():
+            res = deck.run_ccx(text, cmodel, ccx_dir, a.ccx)
+            ccx_peaks.append(res.get("peak_rss_mb") or 0.0)
+            return res, res["ok"], res["wall_seconds"]
+
+        runs.append(ccx_once)
+    # both timed, in turn: ours, ccx, ccx, ours, ... (`interleaved`; ccx's threads in
+    # the environment of its runs only)
+    threads = str(a.threads)
+    old = {k: os.environ.get(k) for k in ("OMP_NUM_THREADS", "CCX_NPROC_EQUATION_SOLVER")}
+    os.environ.update(OMP_NUM_THREADS=threads, CCX_NPROC_EQUATION_SOLVER=threads)
+    try:
+        timed = interleaved(runs, a)
+    finally:
+        for k, v in old.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
+    rc, walls = timed[0]
+    wall, rss = statistics.median(walls), max(our_peaks)
     log = (level_dir / (name + ".solve.log")).read_text()
     m = re.search(r"(\d+) free dofs", log)
     row["dofs"] = int(m.group(1)) if m else None
@@ -256,35 +300,10 @@ def run_level(model, spec, n, a, out_root):
         row["ours"].update(our_answers(level_dir, name, spec))
     if a.no_ccx:
         return row
-    # ccx, timed
-    P = deck.resolve_pipeline(pipeline, 0, msh)
-    P["options"] = " --msh %s" % msh.name + (" --contact surface" if a.contact == "surface" else "")
-    mesh = deck.read_mesh(P["msh"])
-    text, cmodel = deck.build_deck(P, mesh, ran=a.ccx_ran if a.ccx_ran is not None else spec.get("ccx_ran"), ctype=a.contact)
-    ccx_dir = level_dir / "ccx"
-    ccx_dir.mkdir(exist_ok=True)
-    (ccx_dir / (P["name"] + ".inp")).write_text(text)
-    threads = str(a.threads)
-    old = {k: os.environ.get(k) for k in ("OMP_NUM_THREADS", "CCX_NPROC_EQUATION_SOLVER")}
-    os.environ.update(OMP_NUM_THREADS=threads, CCX_NPROC_EQUATION_SOLVER=threads)
-    try:
-        peaks = []
-
-        def ccx_once():
-            res = deck.run_ccx(text, cmodel, ccx_dir, a.ccx)
-            peaks.append(res.get("peak_rss_mb") or 0.0)
-            return res, res["ok"], res["wall_seconds"]
-
-        res, walls = repeated(ccx_once, a)
-        res["wall_seconds"] = statistics.median(walls)
-        res["wall_runs"] = walls
-        res["peak_rss_mb"] = max(peaks) if any(peaks) else res.get("peak_rss_mb")
-    finally:
-        for k, v in old.items():
-            if v is None:
-                os.environ.pop(k, None)
-            else:
-                os.environ[k] = v
+    res, walls = timed[1]
+    res["wall_seconds"] = statistics.median(walls)
+    res["wall_runs"] = walls
+    res["peak_rss_mb"] = max(ccx_peaks) if any(ccx_peaks) else res.get("peak_rss_mb")
     c = dict(ok=bool(res["ok"]) and bool(res.get("final", {}).get("reached_end")), wall_s=res["wall_seconds"], wall_runs=res["wall_runs"],
              peak_rss_mb=res.get("peak_rss_mb"), newton_iterations=res.get("cvg_iterations_total"))
     if res.get("final"):

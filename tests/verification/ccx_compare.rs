@@ -107,3 +107,42 @@ fn parisch_agrees_with_calculix_where_its_residual_floor_binds() {
     assert_eq!(row["ccx"]["newton_iterations"].as_u64(), Some(3));
     assert_eq!(row["ours"]["newton_iterations"].as_u64(), Some(2));
 }
+
+/// The script times the two programs in turn, A B B A A B ..., each until its own
+/// count (`interleaved`), so that a slow spell of the shared machine, or what one
+/// program's run leaves behind, weighs on both medians alike. Fake runs (no ccx)
+/// record the order: eleven short runs each come out as 5½ rounds of A B / B A; a
+/// program whose runs are long stops at its three while the other goes on alone; a
+/// failed run stops that program at once.
+#[test]
+fn the_comparison_times_the_two_programs_in_turn() {
+    let snippet = r#"
+import sys, types
+sys.path.insert(0, sys.argv[1])
+import ccx_compare
+a = types.SimpleNamespace(repeat=3, repeat_below=20.0, repeat_short=11, short_below=1.0)
+def case(walls):
+    order = []
+    def run(name):
+        def once():
+            k = sum(1 for o in order if o == name)
+            order.append(name)
+            ok, wall = walls[name](k)
+            return name + str(k), ok, wall
+        return once
+    out = ccx_compare.interleaved([run("A"), run("B")], a)
+    print("".join(order), [len(w) for _, w in out], [r for r, _ in out])
+case({"A": lambda k: (True, 0.05), "B": lambda k: (True, 0.5)})
+case({"A": lambda k: (True, 0.05), "B": lambda k: (True, 5.0)})
+case({"A": lambda k: (k < 1, 0.05), "B": lambda k: (True, 0.5)})
+"#;
+    let o = Command::new(python()).arg("-c").arg(snippet).arg(repo().join("docs/scripts")).output().expect("python runs");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let out = String::from_utf8_lossy(&o.stdout);
+    let lines: Vec<&str> = out.lines().collect();
+    assert_eq!(lines, [
+        "ABBAABBAABBAABBAABBAAB [11, 11] ['A10', 'B10']",
+        "ABBAABAAAAAAAA [11, 3] ['A10', 'B2']",
+        "ABBABBBBBBBBB [2, 11] ['A1', 'B10']",
+    ], "{out}");
+}
