@@ -12,9 +12,10 @@ For each refinement level of a model:
      ccx), and read each one's wall time and peak RSS (GNU time's %M: wait4 on a
      child of this script would start at the script's own peak); the two programs
      run in turn (ours, ccx, ccx, ours, ours, ccx, ...: a slow minute of the machine
-     falls on both, and each follows the other as often as itself), each --repeat times (3) while its runs take under --repeat-below seconds
-     (20), --repeat-short times (11) while they take under --short-below seconds (1),
-     and each one's median wall time is reported (a first run after the meshing and
+     falls on both, and each follows the other as often as itself), each --repeat
+     times (3) while its runs take under --repeat-below seconds (20), --repeat-short
+     times (11) while they take under --short-below seconds (1), and each one's
+     median wall time is reported (a first run after the meshing and
      tagging took up to 1.8 times the next ones, for either program), the largest peak;
   5. export our result and compare: the largest |u|, the support reaction, the
      total contact normal force and the peak contact pressure, and the Newton
